@@ -1,0 +1,1 @@
+"""Case files shipped with geardyn (TOML)."""

@@ -1,0 +1,92 @@
+"""Mesh stiffness ``K(theta, d, crack)``: analytical (potential energy) and finite-element methods.
+
+Both methods produce a :class:`StiffnessMap` through :func:`build_map`, which caches maps on disk
+keyed by a hash of everything they depend on.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from .map import MapArrays, StiffnessMap, lookup, lookup_reference
+
+__all__ = ["StiffnessMap", "MapArrays", "lookup", "lookup_reference", "build_map",
+           "map_inputs", "centre_distance_grid"]
+
+
+def centre_distance_grid(case) -> np.ndarray:
+    """The centre distance changes of the case's map [m] (``[stiffness]`` section)."""
+    s = case.stiffness
+    return np.linspace(s.centre_distance_min, s.centre_distance_max, s.centre_distances)
+
+
+def map_inputs(case, method: str, cracked: bool) -> dict:
+    """Everything a stiffness map depends on, as plain data (hashed for the cache key)."""
+    from .. import __version__
+
+    data = {
+        "geardyn": __version__,
+        "method": method,
+        "pair": case.pair.model_dump(mode="json"),
+        "pinion": {k: getattr(case.pinion, k) for k in ("teeth", "profile_shift", "bore_radius")},
+        "gear": {k: getattr(case.gear, k) for k in ("teeth", "profile_shift", "bore_radius")},
+        "material": {k: getattr(case.material, k) for k in ("youngs_modulus", "poisson_ratio")},
+        "grid": {k: getattr(case.stiffness, k) for k in
+                 ("centre_distance_min", "centre_distance_max", "centre_distances",
+                  "nodes_per_segment")},
+        "crack": case.crack.model_dump(mode="json") if (cracked and case.crack is not None
+                                                        and case.crack.enabled) else None,
+    }
+    if method == "fe":
+        data["fe"] = case.stiffness.fe.model_dump(mode="json")
+    return data
+
+
+def build_map(case, *, method: str | None = None, cracked: bool = True,
+              progress: Callable[[int, int], None] | None = None, cache=None,
+              ) -> StiffnessMap:
+    """The stiffness map of a case, from the cache or computed.
+
+    Parameters
+    ----------
+    case : geardyn.config.Case
+    method : {"pem", "fe"}, optional
+        Default: ``case.stiffness.method``.
+    cracked : bool
+        Include the case's crack (if it has an enabled one); ``False`` gives the healthy map.
+    progress : callable, optional
+        ``progress(done, total)``.
+    cache : geardyn.cache.Cache, optional
+        Default: :func:`geardyn.cache.default_cache`.
+
+    Returns
+    -------
+    StiffnessMap
+        ``k_mb`` [N/m] on the case's centre-distance grid over one pinion revolution.
+    """
+    from ..cache import cache_key, default_cache
+    from ..errors import InputError
+
+    method = method or case.stiffness.method
+    if method not in ("pem", "fe"):
+        raise InputError("stiffness.method", method, "'pem' or 'fe'")
+    cache = cache or default_cache()
+    inputs = map_inputs(case, method, cracked)
+    key = cache_key(inputs)
+    dd = centre_distance_grid(case)
+
+    def build() -> StiffnessMap:
+        if method == "pem":
+            from .pem import pem_map as make
+        else:
+            from .fe import fe_map as make
+        m = make(case, dd, cracked=cracked, progress=progress)
+        return StiffnessMap(**{**m.__dict__, "attrs": {**dict(m.attrs), "inputs_hash": key}})
+
+    m, _ = cache.get_or_build("stiffness", key, ".nc", build,
+                              save=lambda obj, path: obj.to_dataset().to_netcdf(
+                                  path, engine="h5netcdf"),
+                              load=StiffnessMap.from_netcdf)
+    return m

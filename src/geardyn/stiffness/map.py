@@ -1,0 +1,544 @@
+r"""The stiffness map: mesh stiffness ``K(theta, d)`` over one revolution and a centre-distance range.
+
+Every stiffness method (potential energy, finite elements, a user's table) produces a
+:class:`StiffnessMap`; the dynamics only ever sees its arrays.
+
+Why the nodes are boundary-fitted
+---------------------------------
+In a mesh cycle the number of pairs in contact changes twice: when a pair leaves at the pinion tip
+(``s = s_end``, fixed) and when a new pair enters at the gear tip (``s = s_start(d)``, which moves
+with the centre distance). Blending two ``K(theta)`` curves tabulated at fixed ``theta`` for two
+centre distances therefore smears each step into two half-steps (erratum 6 of
+``design/dynamics.md``). geardyn instead splits each mesh cycle into its two contact zones,
+
+* zone A: from the exit handover ``a`` to the entry handover ``b(d)`` (``floor(eps)`` pairs),
+* zone B: from ``b(d)`` to the next exit handover ``a + Theta_m`` (``ceil(eps)`` pairs),
+
+(``Theta_m = 2 pi / z1``), and places ``n_seg`` nodes across each zone, the end nodes holding the
+one-sided limits. Interpolation between centre distances happens at equal *fraction of the zone*,
+so the steps stay sharp at the right place for every ``d``, and interpolation along ``theta`` never
+crosses a step.
+
+Layout of the arrays (``values[i_d, node]``, ``node = (2 c + zone) n_seg + j``)
+--------------------------------------------------------------------------------
+``dd[i]``            centre distance change of grid line ``i`` [m], uniform spacing;
+``phase_a[i]``       pinion angle of the exit handover that starts cycle 0 [rad];
+``length_a[i]``      length of zone A [rad] (``(2 - eps) Theta_m`` for ``1 < eps < 2``);
+``n_cycles``         mesh cycles in the map's period (``z1`` for one pinion revolution);
+``n_seg``            nodes per zone.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from typing import NamedTuple
+
+import numba
+import numpy as np
+
+from ..errors import InputError
+
+__all__ = [
+    "StiffnessMap",
+    "MapArrays",
+    "lookup",
+    "lookup_reference",
+    "zone_boundaries",
+]
+
+
+class MapArrays(NamedTuple):
+    """The plain arrays compiled code needs to evaluate a map (see :func:`lookup`)."""
+
+    dd0: float  # first centre distance change [m]
+    ddd: float  # grid spacing [m] (0 if one grid line)
+    phase_a: np.ndarray  # (n_d,) [rad]
+    length_a: np.ndarray  # (n_d,) [rad]
+    mesh_angle: float  # Theta_m [rad]
+    n_cycles: int
+    n_seg: int
+    values: np.ndarray  # (n_d, n_cycles * 2 * n_seg) [N/m]
+
+
+@numba.njit(cache=True, nogil=True, fastmath=False)
+def lookup(theta, dd, dd0, ddd, phase_a, length_a, mesh_angle, n_cycles, n_seg, values):
+    """Evaluate a boundary-fitted map at pinion angle ``theta`` [rad] and change ``dd`` [m].
+
+    Returns NaN when ``dd`` lies outside the map's centre-distance range (by more than 1e-9 of
+    the spacing) so callers can stop with a clear error. A single grid line is constant in ``dd``.
+    """
+    n_d = values.shape[0]
+    # -- centre-distance cell
+    if n_d == 1:
+        i = 0
+        w = 0.0
+    else:
+        x = (dd - dd0) / ddd
+        if x < -1e-9 or x > (n_d - 1) + 1e-9:
+            return np.nan
+        i = int(math.floor(x))
+        if i < 0:
+            i = 0
+        if i > n_d - 2:
+            i = n_d - 2
+        w = x - i
+        if w < 0.0:
+            w = 0.0
+        if w > 1.0:
+            w = 1.0
+    i2 = i + 1 if n_d > 1 else 0
+    a = phase_a[i] + w * (phase_a[i2] - phase_a[i])
+    la = length_a[i] + w * (length_a[i2] - length_a[i])
+    # -- cycle, zone and fraction at this centre distance
+    period = n_cycles * mesh_angle
+    r = (theta - a) % period
+    c = int(math.floor(r / mesh_angle))
+    if c >= n_cycles:
+        c = n_cycles - 1
+    r -= c * mesh_angle
+    if la > 1e-12 * mesh_angle and r < la:
+        zone = 0
+        f = r / la
+    else:
+        zone = 1
+        lb = mesh_angle - la
+        f = (r - la) / lb if lb > 1e-12 * mesh_angle else 0.0
+        if f < 0.0:
+            f = 0.0
+    if f > 1.0:
+        f = 1.0
+    u = f * (n_seg - 1)
+    j = int(math.floor(u))
+    if j > n_seg - 2:
+        j = n_seg - 2
+    t = u - j
+    base = (2 * c + zone) * n_seg + j
+    v1 = values[i, base] * (1.0 - t) + values[i, base + 1] * t
+    if n_d == 1:
+        return v1
+    v2 = values[i2, base] * (1.0 - t) + values[i2, base + 1] * t
+    return v1 * (1.0 - w) + v2 * w
+
+
+def lookup_reference(theta: np.ndarray, dd: np.ndarray, arrays: MapArrays) -> np.ndarray:
+    """Pure-NumPy twin of :func:`lookup`, written independently (``np.interp`` per zone).
+
+    Used by the tests to check the compiled kernel; vectorised over ``theta`` and ``dd``.
+    """
+    theta, dd = np.broadcast_arrays(np.asarray(theta, float), np.asarray(dd, float))
+    out = np.empty(theta.shape)
+    n_d = arrays.values.shape[0]
+    tm = arrays.mesh_angle
+    period = arrays.n_cycles * tm
+    grid = arrays.dd0 + arrays.ddd * np.arange(n_d)
+    fr = np.linspace(0.0, 1.0, arrays.n_seg)
+    for idx in np.ndindex(theta.shape):
+        th, d = theta[idx], dd[idx]
+        if n_d == 1:
+            lines, weights = [0], [1.0]
+            a, la = arrays.phase_a[0], arrays.length_a[0]
+        else:
+            if d < grid[0] - 1e-9 * arrays.ddd or d > grid[-1] + 1e-9 * arrays.ddd:
+                out[idx] = np.nan
+                continue
+            a = np.interp(d, grid, arrays.phase_a)
+            la = np.interp(d, grid, arrays.length_a)
+            i = min(max(np.searchsorted(grid, d, side="right") - 1, 0), n_d - 2)
+            w = min(max((d - grid[i]) / arrays.ddd, 0.0), 1.0)
+            lines, weights = [i, i + 1], [1 - w, w]
+        r = np.mod(th - a, period)
+        c = min(int(r // tm), arrays.n_cycles - 1)
+        r -= c * tm
+        if r < la:
+            zone, f = 0, r / la
+        else:
+            zone, f = 1, (r - la) / (tm - la)
+        f = min(max(f, 0.0), 1.0)
+        start = (2 * c + zone) * arrays.n_seg
+        out[idx] = sum(wt * np.interp(f, fr, arrays.values[ln, start:start + arrays.n_seg])
+                       for ln, wt in zip(lines, weights, strict=True))
+    return out
+
+
+def zone_boundaries(pair, dd: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Geometric exit phase ``a`` and zone-A length for each centre distance change.
+
+    Parameters
+    ----------
+    pair : geardyn.geometry.GearPair
+    dd : ndarray
+        Centre distance changes [m].
+
+    Returns
+    -------
+    phase_a : ndarray
+        Pinion angle at which a pair leaves mesh at the pinion tip, in ``[0, Theta_m)`` [rad]
+        (independent of ``dd``: the pinion tip position along the LOA is fixed).
+    length_a : ndarray
+        Length of the zone from that exit to the next entry at the gear tip [rad]:
+        ``(ceil(eps) - eps) Theta_m`` (``(2 - eps) Theta_m`` for ``1 < eps < 2``).
+    """
+    rb1 = pair.pinion.base_radius
+    tm = pair.mesh_angle
+    pa, la = [], []
+    for d in np.atleast_1d(dd):
+        op = pair.operating(float(d), check=False)
+        a = ((op.s_end - pair.pitch_point_s) / rb1) % tm
+        b = ((op.s_start - pair.pitch_point_s) / rb1) % tm
+        pa.append(a)
+        la.append((b - a) % tm)
+    return np.asarray(pa), np.asarray(la)
+
+
+def _hash_inputs(obj: object) -> str:
+    return hashlib.sha256(json.dumps(obj, sort_keys=True, default=str).encode()).hexdigest()[:20]
+
+
+@dataclass(frozen=True)
+class StiffnessMap:
+    """Mesh stiffness over one period of pinion angle and a range of centre distance changes.
+
+    Attributes
+    ----------
+    dd : ndarray, shape (n_d,)
+        Centre distance changes ``d' - d`` of the grid lines [m], uniformly spaced.
+    phase_a, length_a : ndarray, shape (n_d,)
+        Exit-handover phase and zone-A length per grid line [rad] (see module docstring).
+    mesh_angle : float
+        Pinion angle of one mesh cycle ``2 pi / z1`` [rad].
+    n_cycles : int
+        Mesh cycles in the period (``z1``: one pinion revolution).
+    n_seg : int
+        Nodes per contact zone.
+    k_mb : ndarray, shape (n_d, n_cycles * 2 * n_seg)
+        Translational mesh stiffness along the line of action at the nodes [N/m].
+    base_radius : float
+        Pinion base radius ``r_b1`` [m]; ``K_t = k_mb r_b1^2`` [N m/rad].
+    extra : dict of str -> ndarray
+        Further per-node variables, each ``(n_d, nodes, ...)``: ``load_share``
+        (``(n_d, nodes, 3)``, share of the pairs ``slot_tooth`` of each cycle) [-],
+        ``pairs_in_contact`` [-], ``transmission_error`` [rad] (FE).
+    slot_tooth : ndarray of int, shape (n_cycles, 3)
+        Pinion tooth of load-share slot k in cycle c (slots ordered by entry into mesh).
+    attrs : dict
+        Provenance: method, parameters, inputs hash, geardyn version, citations.
+    """
+
+    dd: np.ndarray
+    phase_a: np.ndarray
+    length_a: np.ndarray
+    mesh_angle: float
+    n_cycles: int
+    n_seg: int
+    k_mb: np.ndarray
+    base_radius: float
+    extra: Mapping[str, np.ndarray] = field(default_factory=dict)
+    slot_tooth: np.ndarray | None = None
+    attrs: Mapping[str, object] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        dd = np.asarray(self.dd, float)
+        if dd.ndim != 1 or dd.size < 1:
+            raise InputError("dd", self.dd, "a 1-D array of centre distance changes [m]")
+        if dd.size > 1:
+            step = np.diff(dd)
+            if np.any(step <= 0) or np.ptp(step) > 1e-9 * max(abs(step[0]), 1e-30) + 1e-15:
+                raise InputError("dd", self.dd, "uniformly spaced, increasing values")
+        nodes = self.n_cycles * 2 * self.n_seg
+        if self.k_mb.shape != (dd.size, nodes):
+            raise InputError("k_mb", self.k_mb.shape, f"shape ({dd.size}, {nodes})")
+        if not np.all(np.isfinite(self.k_mb)) or np.any(self.k_mb < 0):
+            raise InputError("k_mb", "non-finite or negative entries", "finite values >= 0 [N/m]")
+
+    # --------------------------------------------------------------- construction
+    @property
+    def period(self) -> float:
+        """Pinion angle covered by the map [rad]."""
+        return self.n_cycles * self.mesh_angle
+
+    @staticmethod
+    def node_fractions(n_seg: int) -> np.ndarray:
+        """Fractions of a zone at which nodes sit: ``linspace(0, 1, n_seg)``."""
+        return np.linspace(0.0, 1.0, n_seg)
+
+    @staticmethod
+    def node_angles(phase_a: float, length_a: float, mesh_angle: float, n_cycles: int,
+                    n_seg: int, nudge: float = 1e-9) -> np.ndarray:
+        """Pinion angles of the nodes of one grid line [rad], shape ``(n_cycles * 2 * n_seg,)``.
+
+        End nodes are moved ``nudge * mesh_angle`` into their zone, so a method evaluated there
+        returns the one-sided limit of a step.
+        """
+        f = StiffnessMap.node_fractions(n_seg)
+        eps = nudge * mesh_angle
+        out = np.empty((n_cycles, 2, n_seg))
+        lb = mesh_angle - length_a
+        for c in range(n_cycles):
+            start = phase_a + c * mesh_angle
+            out[c, 0] = start + f * length_a
+            out[c, 1] = start + length_a + f * lb
+        if n_seg > 1:
+            out[:, :, 0] += min(eps, 0.25 * max(min(length_a, lb), 0) / max(n_seg - 1, 1))
+            out[:, :, -1] -= min(eps, 0.25 * max(min(length_a, lb), 0) / max(n_seg - 1, 1))
+        return out.reshape(-1)
+
+    @classmethod
+    def from_function(cls, pair, dd: np.ndarray, fn: Callable[[np.ndarray, float], Mapping],
+                      *, n_cycles: int | None = None, n_seg: int = 24,
+                      attrs: Mapping[str, object] | None = None,
+                      progress: Callable[[int, int], None] | None = None) -> StiffnessMap:
+        """Build a map by evaluating ``fn(theta_nodes, dd_i)`` on each grid line.
+
+        Parameters
+        ----------
+        pair : geardyn.geometry.GearPair
+        dd : array_like
+            Centre distance changes [m] (uniform, increasing).
+        fn : callable
+            ``fn(theta, dd) -> {"k_mb": (n,), optional "load_share": (n, 3),
+            "pairs_in_contact": (n,), "transmission_error": (n,)}`` for pinion angles ``theta``
+            [rad] at the change ``dd`` [m].
+        n_cycles : int, optional
+            Mesh cycles in the period; default ``z1`` (one pinion revolution).
+        n_seg : int
+            Nodes per contact zone.
+        attrs : mapping, optional
+            Provenance to store.
+        progress : callable, optional
+            ``progress(done, total)`` after each grid line.
+        """
+        dd = np.atleast_1d(np.asarray(dd, float))
+        n_cycles = pair.pinion.teeth if n_cycles is None else int(n_cycles)
+        pa, la = zone_boundaries(pair, dd)
+        tm = pair.mesh_angle
+        rows: dict[str, list[np.ndarray]] = {}
+        for i, d in enumerate(dd):
+            th = cls.node_angles(pa[i], la[i], tm, n_cycles, n_seg)
+            res = fn(th, float(d))
+            for k, v in res.items():
+                rows.setdefault(k, []).append(np.asarray(v, float))
+            if progress is not None:
+                progress(i + 1, len(dd))
+        if "k_mb" not in rows:
+            raise InputError("fn", sorted(rows), "a function returning at least 'k_mb'")
+        k = np.stack(rows.pop("k_mb"))
+        extra = {name: np.stack(v) for name, v in rows.items()}
+        return cls(dd=dd, phase_a=pa, length_a=la, mesh_angle=tm, n_cycles=n_cycles,
+                   n_seg=n_seg, k_mb=k, base_radius=pair.pinion.base_radius, extra=extra,
+                   slot_tooth=slot_teeth(pair, float(pa[0]), n_cycles),
+                   attrs=dict(attrs or {}))
+
+    @classmethod
+    def from_table(cls, pair, theta: np.ndarray, k_mb: np.ndarray, dd: np.ndarray | None = None,
+                   *, n_seg: int = 64, attrs: Mapping[str, object] | None = None
+                   ) -> StiffnessMap:
+        """A map from a user's table of ``k_mb`` [N/m] on a regular pinion-angle grid.
+
+        Parameters
+        ----------
+        pair : geardyn.geometry.GearPair
+        theta : array_like, shape (n_theta,)
+            Pinion angles [rad], increasing, covering one period (one mesh cycle or one pinion
+            revolution; the table is repeated to fill a revolution).
+        k_mb : array_like, shape (n_theta,) or (n_d, n_theta)
+            Mesh stiffness along the LOA [N/m].
+        dd : array_like, optional
+            Centre distance changes of the rows [m]; omit for one row (constant in ``d``).
+        n_seg : int
+            Nodes per contact zone of the resampled map.
+        """
+        theta = np.asarray(theta, float)
+        k2 = np.atleast_2d(np.asarray(k_mb, float))
+        if theta.ndim != 1 or theta.size < 4 or np.any(np.diff(theta) <= 0):
+            raise InputError("theta", theta.shape, "an increasing 1-D array of >= 4 angles [rad]")
+        if k2.shape[-1] != theta.size:
+            raise InputError("k_mb", k2.shape, f"last axis of length {theta.size} (as theta)")
+        if dd is None:
+            if k2.shape[0] != 1:
+                raise InputError("dd", None, f"{k2.shape[0]} centre distance changes for the rows")
+            dd = np.array([0.0])
+        dd = np.atleast_1d(np.asarray(dd, float))
+        if dd.size != k2.shape[0]:
+            raise InputError("dd", dd.size, f"one centre distance change per row ({k2.shape[0]})")
+        span = theta[-1] - theta[0] + (theta[1] - theta[0])
+        tm = pair.mesh_angle
+        cycles_in_table = span / tm
+        if abs(cycles_in_table - round(cycles_in_table)) > 1e-3 or round(cycles_in_table) < 1:
+            raise InputError("theta", f"span {span:.6g} rad",
+                             f"a whole number of mesh cycles ({tm:.6g} rad each) on a regular grid")
+        n_cycles = pair.pinion.teeth
+        rows = {i: k2[i] for i in range(dd.size)}
+
+        def fn(th: np.ndarray, d: float) -> dict:
+            i = int(np.argmin(np.abs(dd - d)))
+            return {"k_mb": np.interp(th, theta, rows[i], period=span)}
+
+        return cls.from_function(pair, dd, fn, n_cycles=n_cycles, n_seg=n_seg,
+                                 attrs={"method": "table", **dict(attrs or {})})
+
+    # --------------------------------------------------------------- evaluation
+    def arrays(self, variable: str = "k_mb") -> MapArrays:
+        """The plain arrays for :func:`lookup` (``variable``: ``"k_mb"`` or an ``extra`` name
+        with one value per node)."""
+        vals = self.k_mb if variable == "k_mb" else self.extra[variable]
+        if vals.ndim != 2:
+            raise InputError("variable", variable, "a variable with one value per node")
+        ddd = float(self.dd[1] - self.dd[0]) if self.dd.size > 1 else 0.0
+        return MapArrays(float(self.dd[0]), ddd, np.ascontiguousarray(self.phase_a),
+                         np.ascontiguousarray(self.length_a), float(self.mesh_angle),
+                         int(self.n_cycles), int(self.n_seg), np.ascontiguousarray(vals))
+
+    def __call__(self, theta, dd=0.0, variable: str = "k_mb") -> np.ndarray:
+        """Evaluate the map at pinion angles ``theta`` [rad] and changes ``dd`` [m].
+
+        Returns ``k_mb`` [N/m] by default; NaN outside the centre-distance range.
+        """
+        arr = self.arrays(variable)
+        th, d = np.broadcast_arrays(np.asarray(theta, float), np.asarray(dd, float))
+        out = _lookup_many(th.ravel(), d.ravel(), *arr)
+        return out.reshape(th.shape) if th.shape else float(out[0])
+
+    def torsional(self, theta, dd=0.0) -> np.ndarray:
+        """Combined torsional mesh stiffness ``K_t = k_mb r_b1^2`` [N m/rad]."""
+        return np.asarray(self(theta, dd)) * self.base_radius ** 2
+
+    def covers(self, dd: float) -> bool:
+        """Whether ``dd`` [m] lies inside the map's centre-distance range."""
+        if self.dd.size == 1:
+            return True
+        return bool(self.dd[0] - 1e-12 <= dd <= self.dd[-1] + 1e-12)
+
+    def node_theta(self) -> np.ndarray:
+        """Pinion angles of the nodes, shape ``(n_d, nodes)`` [rad]."""
+        return np.stack([self.node_angles(a, la, self.mesh_angle, self.n_cycles, self.n_seg)
+                         for a, la in zip(self.phase_a, self.length_a, strict=True)])
+
+    # --------------------------------------------------------------- storage
+    def to_dataset(self):
+        """The map as an :class:`xarray.Dataset` with units and provenance."""
+        import xarray as xr
+
+        nodes = self.k_mb.shape[1]
+        ds = xr.Dataset(
+            {
+                "k_mb": (("centre_distance_change", "node"), self.k_mb,
+                         {"units": "N/m", "long_name": "mesh stiffness along the line of action"}),
+                "torsional_stiffness": (("centre_distance_change", "node"),
+                                        self.k_mb * self.base_radius ** 2,
+                                        {"units": "N m/rad",
+                                         "long_name": "combined torsional mesh stiffness "
+                                                      "K_t = k_mb r_b1^2"}),
+                "phase_a": ("centre_distance_change", self.phase_a,
+                            {"units": "rad", "long_name": "pinion angle of the exit handover"}),
+                "length_a": ("centre_distance_change", self.length_a,
+                             {"units": "rad", "long_name": "length of contact zone A"}),
+            },
+            coords={
+                "centre_distance_change": ("centre_distance_change", self.dd,
+                                           {"units": "m", "long_name": "d' - d"}),
+                "node": ("node", np.arange(nodes), {"long_name": "boundary-fitted node index"}),
+                "theta": (("centre_distance_change", "node"), self.node_theta(),
+                          {"units": "rad", "long_name": "pinion angle of the node"}),
+            },
+        )
+        units = {"load_share": ("1", "load sharing ratio of the slot's tooth pair"),
+                 "pairs_in_contact": ("1", "number of tooth pairs in contact"),
+                 "transmission_error": ("rad", "static transmission error (pinion angle)")}
+        for name, v in self.extra.items():
+            dims = ("centre_distance_change", "node") + tuple(f"{name}_dim{k}"
+                                                              for k in range(2, v.ndim))
+            if name == "load_share":
+                dims = ("centre_distance_change", "node", "slot")
+            u, ln = units.get(name, ("", name))
+            ds[name] = (dims, v, {"units": u, "long_name": ln})
+        if self.slot_tooth is not None:
+            ds["slot_tooth"] = (("cycle", "slot"), self.slot_tooth,
+                                {"long_name": "pinion tooth of each load-share slot"})
+        ds.attrs.update({k: (json.dumps(v) if isinstance(v, dict | list | tuple) else v)
+                         for k, v in self.attrs.items()})
+        ds.attrs.update({"mesh_angle": self.mesh_angle, "mesh_angle_units": "rad",
+                         "n_cycles": self.n_cycles, "n_seg": self.n_seg,
+                         "base_radius": self.base_radius, "base_radius_units": "m",
+                         "geardyn_object": "StiffnessMap"})
+        return ds
+
+    @classmethod
+    def from_dataset(cls, ds) -> StiffnessMap:
+        """Inverse of :meth:`to_dataset`."""
+        reserved = {"k_mb", "torsional_stiffness", "phase_a", "length_a", "slot_tooth"}
+        extra = {n: np.asarray(ds[n].values) for n in ds.data_vars if n not in reserved}
+        attrs = {k: v for k, v in ds.attrs.items()
+                 if k not in ("mesh_angle", "mesh_angle_units", "n_cycles", "n_seg",
+                              "base_radius", "base_radius_units", "geardyn_object")}
+        return cls(
+            dd=np.asarray(ds["centre_distance_change"].values, float),
+            phase_a=np.asarray(ds["phase_a"].values, float),
+            length_a=np.asarray(ds["length_a"].values, float),
+            mesh_angle=float(ds.attrs["mesh_angle"]),
+            n_cycles=int(ds.attrs["n_cycles"]),
+            n_seg=int(ds.attrs["n_seg"]),
+            k_mb=np.asarray(ds["k_mb"].values, float),
+            base_radius=float(ds.attrs["base_radius"]),
+            extra=extra,
+            slot_tooth=np.asarray(ds["slot_tooth"].values) if "slot_tooth" in ds else None,
+            attrs=attrs,
+        )
+
+    def to_netcdf(self, path) -> None:
+        """Write the map to NetCDF atomically (temp file, then rename)."""
+        from ..io import write_netcdf_atomic
+
+        write_netcdf_atomic(self.to_dataset(), path)
+
+    @classmethod
+    def from_netcdf(cls, path) -> StiffnessMap:
+        """Read a map written by :meth:`to_netcdf`."""
+        from ..io import read_netcdf
+
+        ds = read_netcdf(path, required=("k_mb", "phase_a", "length_a"))
+        return cls.from_dataset(ds)
+
+    def regular(self, n_theta: int = 360, dd: np.ndarray | None = None):
+        """The map resampled on a regular ``(dd, theta)`` grid, as an xarray DataArray [N/m]."""
+        import xarray as xr
+
+        dd = self.dd if dd is None else np.atleast_1d(np.asarray(dd, float))
+        th = np.linspace(0.0, self.period, n_theta, endpoint=False)
+        vals = self(th[None, :], dd[:, None])
+        return xr.DataArray(vals, dims=("centre_distance_change", "theta"),
+                            coords={"centre_distance_change": ("centre_distance_change", dd,
+                                                               {"units": "m"}),
+                                    "theta": ("theta", th, {"units": "rad"})},
+                            attrs={"units": "N/m", "long_name": "mesh stiffness along the LOA"},
+                            name="k_mb")
+
+
+@numba.njit(cache=True, nogil=True, fastmath=False)
+def _lookup_many(theta, dd, dd0, ddd, phase_a, length_a, mesh_angle, n_cycles, n_seg, values):
+    out = np.empty(theta.size)
+    for k in range(theta.size):
+        out[k] = lookup(theta[k], dd[k], dd0, ddd, phase_a, length_a, mesh_angle, n_cycles,
+                        n_seg, values)
+    return out
+
+
+def slot_teeth(pair, phase_a: float, n_cycles: int) -> np.ndarray:
+    """Pinion tooth of each load-share slot: slot ``k`` of cycle ``c`` is pair
+    ``n_exit(c) + 1 + k``, where ``n_exit(c)`` is the pair leaving mesh as the cycle starts."""
+    rb1, pb = pair.pinion.base_radius, pair.base_pitch
+    op = pair.operating(0.0, check=False)
+    out = np.empty((n_cycles, 3), dtype=np.int64)
+    for c in range(n_cycles):
+        theta = phase_a + c * pair.mesh_angle
+        n_exit = round((pair.pitch_point_s + rb1 * theta - op.s_end) / pb)
+        out[c] = np.mod(n_exit + 1 + np.arange(3), pair.pinion.teeth)
+    return out
+
+
+def inputs_hash(payload: Mapping[str, object]) -> str:
+    """Short SHA-256 of a JSON-serialisable description of a map's inputs."""
+    return _hash_inputs(payload)
