@@ -29,6 +29,7 @@ from pydantic import (
     Field,
     ValidationError,
     WithJsonSchema,
+    field_validator,
     model_validator,
 )
 
@@ -90,13 +91,20 @@ class PairConfig(_Model):
     """Tooth system shared by both gears (ISO 53 basic rack by default)."""
 
     module: Length = Field(gt=0, description="Module m [m].")
-    pressure_angle: Angle = Field(gt=0, le=math.radians(35),
-                                  description="Pressure angle of the basic rack [rad], (0, 35 deg].")
+    pressure_angle: Angle = Field(description="Pressure angle of the basic rack [rad], (0, 35 deg].")
     addendum_coefficient: float = Field(1.0, gt=0, le=2, description="h_a* [-].")
     dedendum_coefficient: float = Field(1.25, gt=0, le=3, description="h_f* [-].")
     tool_tip_radius_coefficient: float | None = Field(
         None, ge=0, description="Rack tip radius rho* [-]; omit for (h_f*-h_a*)/(1-sin alpha).")
     face_width: Length = Field(gt=0, description="Face width b [m] (both gears).")
+
+
+    @field_validator("pressure_angle")
+    @classmethod
+    def _pressure_angle(cls, v: float) -> float:
+        if not (0 < v <= math.radians(35)):
+            raise ValueError(f"a pressure angle in (0, 35] deg (this is {math.degrees(v):.6g} deg)")
+        return v
 
 
 class GearConfig(_Model):
@@ -412,10 +420,23 @@ def _format_validation_error(exc: ValidationError, data: Mapping[str, Any]) -> I
               f"{', '.join(allowed)}"
     elif first["type"] == "missing":
         msg = "a value (this required field is missing)"
-    value = first.get("input", None)
+    value = _raw_value(data, first["loc"], first.get("input", None))
     more = f" (and {len(errs) - 1} more problem{'s' if len(errs) > 2 else ''})" if len(errs) > 1 \
         else ""
     return InputError(loc or "case", value, msg + more)
+
+
+def _raw_value(data: Mapping[str, Any], loc: tuple, default: Any) -> Any:
+    """The value as the user wrote it (before unit conversion), found by its location."""
+    node: Any = data
+    for p in loc:
+        if isinstance(node, Mapping) and p in node:
+            node = node[p]
+        elif isinstance(node, list) and isinstance(p, int) and p < len(node):
+            node = node[p]
+        else:
+            return default
+    return node
 
 
 def _allowed_keys(parent: str) -> list[str]:

@@ -700,3 +700,75 @@ def centre_distance_from_displacements(pair: GearPair, y_p: float | np.ndarray,
     return np.hypot(rsum, pair.design_t1t2 + np.asarray(y_g) - np.asarray(y_p)) \
         if isinstance(y_p, np.ndarray) or isinstance(y_g, np.ndarray) \
         else math.hypot(rsum, pair.design_t1t2 + y_g - y_p)
+
+
+def static_operating_point(pair: GearPair, torque: float, pinion_bearing_stiffness: float,
+                           gear_bearing_stiffness: float) -> OperatingGeometry:
+    r"""Operating geometry under a static torque on rigid teeth and flexible bearings.
+
+    The mesh force along the LOA is ``N = T / r_b1``; it pushes the pinion to ``y_p = -N/k_yp``
+    and the gear to ``y_g = +N/k_yg`` (eqs. 10 and 12 at rest), and eq. 4 gives ``d'``.
+    For the paper's case: N = 1542.3 N, d' - d = 1.0852 mm.
+
+    Parameters
+    ----------
+    pair : GearPair
+    torque : float
+        Input torque on the pinion [N m].
+    pinion_bearing_stiffness, gear_bearing_stiffness : float
+        Bearing stiffnesses along the LOA [N/m].
+    """
+    n = torque / pair.pinion.base_radius
+    d = centre_distance_from_displacements(pair, -n / pinion_bearing_stiffness,
+                                           n / gear_bearing_stiffness)
+    return pair.operating(float(d) - pair.design_centre_distance)
+
+
+def geometry_summary(pair: GearPair, centre_distance_change: float = 0.0) -> dict:
+    """A JSON-ready summary of the pair at ``d + centre_distance_change`` [m].
+
+    Keys carry their unit as a suffix (``_m``, ``_deg``); everything else is dimensionless.
+    """
+    op = pair.operating(centre_distance_change)
+
+    def gear_dict(g: Gear) -> dict:
+        return {
+            "teeth": int(g.teeth),
+            "module_m": g.module,
+            "pressure_angle_deg": math.degrees(g.pressure_angle),
+            "profile_shift": g.profile_shift,
+            "pitch_radius_m": g.pitch_radius,
+            "base_radius_m": g.base_radius,
+            "tip_radius_m": g.tip_radius,
+            "root_radius_m": g.root_radius,
+            "form_radius_m": g.form_radius,
+            "tool_tip_radius_m": g.tool_tip_radius,
+            "tip_thickness_m": g.tip_thickness,
+            "root_half_angle_rad": g.root_half_angle,
+            "face_width_m": g.face_width,
+            "bore_radius_m": g.bore_radius,
+        }
+
+    return {
+        "pinion": gear_dict(pair.pinion),
+        "gear": gear_dict(pair.gear),
+        "base_pitch_m": pair.base_pitch,
+        "design_centre_distance_m": pair.design_centre_distance,
+        "design_pressure_angle_deg": math.degrees(pair.working_pressure_angle),
+        "operating": {
+            "centre_distance_m": op.centre_distance,
+            "centre_distance_change_m": op.centre_distance_change,
+            "pressure_angle_deg": math.degrees(op.pressure_angle),
+            "contact_ratio": {"physical": op.contact_ratio, "paper_eq8": op.contact_ratio_eq8},
+            "single_contact_fraction": op.single_contact_fraction,
+            "double_contact_fraction": op.double_contact_fraction,
+            "contact_start_m": op.s_start,
+            "contact_end_m": op.s_end,
+            "t1t2_m": op.t1t2,
+            "normal_backlash_m": op.normal_backlash,
+            "circumferential_backlash_m": op.circumferential_backlash,
+            "backlash_closing_rotation_rad": op.closing_rotation,
+        },
+        "max_centre_distance_change_m": pair.max_centre_distance_change(),
+        "checks": pair.checks(centre_distance_change),
+    }

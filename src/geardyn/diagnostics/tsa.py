@@ -5,7 +5,7 @@ signal over whole shaft revolutions, sampled on an equispaced grid of shaft angl
 
 .. math::
 
-    \\bar x(\\theta_n) = \\frac{1}{R} \\sum_{r=0}^{R-1} x\\bigl(\\theta_0 + 2\\pi r + \\theta_n\\bigr),
+    \\bar x(\\theta_n) = \\frac{1}{R} \\sum_{r=0}^{R-1} x(\\theta_0 + 2\\pi r + \\theta_n),
     \\qquad \\theta_n = 2\\pi n / N, \\quad n = 0, \\dots, N-1,
 
 where :math:`x(\\theta)` is the signal as a function of the (unwrapped) shaft angle, :math:`R` the

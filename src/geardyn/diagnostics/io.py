@@ -1,0 +1,354 @@
+"""Readers for measured data (CSV/text, NumPy .npy/.npz, MATLAB .mat) and simulation results.
+
+All readers return float64 channels keyed by name, in file order, so that a channel can be
+picked by name or by position. Problems with the file itself (missing, unreadable, truncated,
+corrupt, unsupported format) raise :class:`geardyn.errors.DataFileError`; asking for a channel
+the file does not have raises :class:`geardyn.errors.InputError` listing the channels it has.
+
+Layout rules
+------------
+CSV / text (``.csv``, ``.txt``, ``.tsv``, ``.dat``)
+    One channel per column. The delimiter is detected from the first data line (comma,
+    semicolon, tab, else whitespace); lines starting with ``#`` are comments. If the first line
+    has a non-numeric field it is a header of column names, otherwise columns are named
+    ``"0"``, ``"1"``, ... Empty fields are read as NaN (e.g. a shorter column of tachometer
+    pulse times); a row with a different number of fields is a truncated/corrupt file.
+``.npy``
+    A 1-D array is channel ``"0"``; a 2-D array holds one channel per column along its longer
+    axis (samples along the longer axis).
+``.npz``
+    Every 1-D array is a channel under its name; a 2-D array ``a`` gives channels ``a[0]``,
+    ``a[1]``, ... (samples along the longer axis); scalars (e.g. ``fs``) go to ``scalars``.
+``.mat``
+    MATLAB v4-v7.2 via :func:`scipy.io.loadmat`, v7.3 (HDF5) via h5py. Variables are channels
+    as for ``.npz``.
+"""
+
+from __future__ import annotations
+
+import os
+import zipfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from geardyn.errors import DataFileError, InputError
+
+__all__ = ["DataTable", "read_table", "read_simulation", "TEXT_SUFFIXES", "NETCDF_SUFFIXES"]
+
+TEXT_SUFFIXES = (".csv", ".txt", ".tsv", ".dat")
+NETCDF_SUFFIXES = (".nc", ".nc4", ".netcdf", ".h5", ".hdf5")
+
+
+@dataclass(frozen=True)
+class DataTable:
+    """Channels read from one file.
+
+    Attributes
+    ----------
+    path : str
+        The file.
+    columns : dict of str to ndarray
+        Channel name -> 1-D float64 array (file unit), in file order.
+    scalars : dict of str to float
+        Scalar numeric entries of ``.npz``/``.mat`` files (e.g. a stored ``fs``).
+    """
+
+    path: str
+    columns: dict[str, np.ndarray]
+    scalars: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def names(self) -> list[str]:
+        """Channel names in file order."""
+        return list(self.columns)
+
+    def get(self, spec: str | int, field_name: str = "column") -> np.ndarray:
+        """Channel by name or position.
+
+        Parameters
+        ----------
+        spec : str or int
+            Column name, or 0-based position (a string of digits that is not a name is taken
+            as a position).
+        field_name : str
+            Argument name used in the error message.
+
+        Raises
+        ------
+        InputError
+            No such channel (the message lists the available ones).
+        """
+        names = self.names
+        if isinstance(spec, str) and spec in self.columns:
+            return self.columns[spec]
+        idx = None
+        if isinstance(spec, (int, np.integer)) and not isinstance(spec, bool):
+            idx = int(spec)
+        elif isinstance(spec, str) and spec.strip().lstrip("-").isdigit():
+            idx = int(spec)
+        if idx is not None and -len(names) <= idx < len(names):
+            return self.columns[names[idx]]
+        shown = ", ".join(repr(n) for n in names[:20]) + (" ..." if len(names) > 20 else "")
+        raise InputError(field_name, spec,
+                         f"a column of {Path(self.path).name}: one of {shown} "
+                         f"or a position 0..{len(names) - 1}")
+
+
+def _check_path(path) -> Path:
+    p = Path(path)
+    if not p.exists():
+        raise DataFileError(p, "no such file")
+    if p.is_dir():
+        raise DataFileError(p, "is a directory, not a data file")
+    if not os.access(p, os.R_OK):
+        raise DataFileError(p, "not readable (permission denied)")
+    if p.stat().st_size == 0:
+        raise DataFileError(p, "empty file")
+    return p
+
+
+def read_table(path) -> DataTable:
+    """Read a measured-data file into named float64 channels (see the module docstring).
+
+    Parameters
+    ----------
+    path : str or path-like
+        ``.csv``/``.txt``/``.tsv``/``.dat``, ``.npy``, ``.npz`` or ``.mat``.
+
+    Returns
+    -------
+    DataTable
+
+    Raises
+    ------
+    DataFileError
+        Missing, empty, unreadable, truncated or corrupt file; unsupported format.
+    """
+    p = _check_path(path)
+    suffix = p.suffix.lower()
+    if suffix in TEXT_SUFFIXES:
+        return _read_text(p)
+    if suffix == ".npy":
+        return _read_npy(p)
+    if suffix == ".npz":
+        return _read_npz(p)
+    if suffix == ".mat":
+        return _read_mat(p)
+    raise DataFileError(p, f"unsupported format {suffix!r}; use .csv/.txt/.tsv/.dat, .npy, "
+                           ".npz, .mat (measured data) or .nc (geardyn simulation result)")
+
+
+# --------------------------------------------------------------------------------------------
+def _read_text(p: Path) -> DataTable:
+    try:
+        with open(p, encoding="utf-8-sig") as fh:
+            lines = fh.read().splitlines()
+    except UnicodeDecodeError as exc:
+        raise DataFileError(p, f"not a text file ({exc.reason} at byte {exc.start})") from exc
+    except OSError as exc:  # pragma: no cover - races
+        raise DataFileError(p, f"cannot read: {exc}") from exc
+    body = [(i + 1, ln) for i, ln in enumerate(lines)
+            if ln.strip() and not ln.lstrip().startswith("#")]
+    if not body:
+        raise DataFileError(p, "no data lines")
+    first = body[0][1]
+    delim = "," if "," in first else ";" if ";" in first else "\t" if "\t" in first else None
+
+    def split(line: str) -> list[str]:
+        return [t.strip() for t in (line.split(delim) if delim else line.split())]
+
+    head = split(first)
+    header = None
+    try:
+        [float(t) for t in head]
+    except ValueError:
+        header = [h.strip('"').strip("'") or str(i) for i, h in enumerate(head)]
+        body = body[1:]
+    if not body:
+        raise DataFileError(p, "a header but no data rows")
+    ncol = len(head)
+    data = None
+    try:  # fast path (C parser); the line loop below gives precise messages and NaN fields
+        fast = np.loadtxt(p, delimiter=delim, comments="#", ndmin=2, encoding="utf-8-sig",
+                          skiprows=body[0][0] - 1, dtype=np.float64)
+        if fast.shape == (len(body), ncol):
+            data = fast
+    except ValueError:
+        pass
+    if data is None:
+        data = _parse_lines(p, body, ncol, split)
+    names = header or [str(i) for i in range(ncol)]
+    if len(set(names)) != len(names):
+        raise DataFileError(p, f"duplicate column names in the header: {names}")
+    return DataTable(str(p), {n: data[:, j].copy() for j, n in enumerate(names)})
+
+
+def _parse_lines(p: Path, body, ncol: int, split) -> np.ndarray:
+    data = np.empty((len(body), ncol), dtype=np.float64)
+    for r, (lineno, line) in enumerate(body):
+        toks = split(line)
+        if len(toks) != ncol:
+            raise DataFileError(p, f"line {lineno} has {len(toks)} fields, expected {ncol} "
+                                   "(truncated or corrupt file?)")
+        try:
+            data[r] = [float(t) if t else np.nan for t in toks]
+        except ValueError as exc:
+            raise DataFileError(p, f"line {lineno}: non-numeric value ({exc})") from exc
+    return data
+
+
+def _split_2d(name: str, arr: np.ndarray, out: dict, scalars: dict) -> None:
+    arr = np.asarray(arr)
+    if arr.dtype.kind not in "biuf":
+        return  # strings, structs, cells: not channels
+    arr = np.squeeze(arr).astype(np.float64)
+    if arr.ndim == 0:
+        scalars[name] = float(arr)
+    elif arr.ndim == 1:
+        out[name] = arr
+    elif arr.ndim == 2:
+        if arr.shape[0] < arr.shape[1]:
+            arr = arr.T
+        for j in range(arr.shape[1]):
+            out[f"{name}[{j}]"] = np.ascontiguousarray(arr[:, j])
+    # higher dimensions are not channels: ignored
+
+
+def _read_npy(p: Path) -> DataTable:
+    try:
+        arr = np.load(p, allow_pickle=False)
+    except (ValueError, OSError, EOFError) as exc:
+        raise DataFileError(p, f"not a readable .npy file ({exc})") from exc
+    if arr.dtype.kind not in "biuf":
+        raise DataFileError(p, f"holds {arr.dtype} data, not numbers")
+    arr = np.squeeze(arr).astype(np.float64)
+    if arr.ndim == 1:
+        return DataTable(str(p), {"0": arr})
+    if arr.ndim != 2:
+        raise DataFileError(p, f"array of shape {arr.shape}; expected 1-D or 2-D")
+    if arr.shape[0] < arr.shape[1]:
+        arr = arr.T
+    return DataTable(str(p), {str(j): np.ascontiguousarray(arr[:, j])
+                              for j in range(arr.shape[1])})
+
+
+def _read_npz(p: Path) -> DataTable:
+    cols: dict[str, np.ndarray] = {}
+    scalars: dict[str, float] = {}
+    try:
+        with np.load(p, allow_pickle=False) as z:
+            for name in z.files:
+                _split_2d(name, z[name], cols, scalars)
+    except (ValueError, OSError, EOFError, zipfile.BadZipFile, KeyError) as exc:
+        raise DataFileError(p, f"not a readable .npz file ({exc})") from exc
+    if not cols:
+        raise DataFileError(p, "no numeric 1-D or 2-D arrays")
+    return DataTable(str(p), cols, scalars)
+
+
+def _read_mat(p: Path) -> DataTable:
+    import scipy.io
+
+    cols: dict[str, np.ndarray] = {}
+    scalars: dict[str, float] = {}
+    try:
+        content = scipy.io.loadmat(p, squeeze_me=True)
+    except NotImplementedError:
+        return _read_mat73(p)
+    except Exception as exc:  # scipy raises ValueError, MatReadError, OSError, TypeError...
+        raise DataFileError(p, f"not a readable MATLAB file ({type(exc).__name__}: {exc})"
+                            ) from exc
+    for name, value in content.items():
+        if name.startswith("__"):
+            continue
+        _split_2d(name, value, cols, scalars)
+    if not cols:
+        raise DataFileError(p, "no numeric vector or matrix variables")
+    return DataTable(str(p), cols, scalars)
+
+
+def _read_mat73(p: Path) -> DataTable:
+    try:
+        import h5py
+    except ImportError as exc:
+        raise DataFileError(p, "MATLAB v7.3 (HDF5) file: reading it needs h5py "
+                               "(pip install h5py), or save it with -v7") from exc
+    cols: dict[str, np.ndarray] = {}
+    scalars: dict[str, float] = {}
+    try:
+        with h5py.File(p, "r") as f:
+            for name, obj in f.items():
+                if isinstance(obj, h5py.Dataset) and not name.startswith("#"):
+                    # MATLAB writes column-major: transpose back
+                    _split_2d(name, np.asarray(obj[()]).T, cols, scalars)
+    except OSError as exc:
+        raise DataFileError(p, f"not a readable MATLAB v7.3/HDF5 file ({exc})") from exc
+    if not cols:
+        raise DataFileError(p, "no numeric vector or matrix variables")
+    return DataTable(str(p), cols, scalars)
+
+
+# --------------------------------------------------------------------------------------------
+def read_simulation(path, variables) -> tuple[np.ndarray, dict[str, np.ndarray], dict]:
+    """Read a geardyn simulation result (NetCDF4/HDF5 written by xarray with h5netcdf).
+
+    Parameters
+    ----------
+    path : str or path-like
+        The ``.nc`` file.
+    variables : sequence of str
+        Data variables to read (e.g. ``theta_p`` [rad], ``v_yg`` [m/s], ``omega_p`` [rad/s],
+        ``transmission_error`` [rad]).
+
+    Returns
+    -------
+    time : ndarray
+        The ``time`` coordinate [s].
+    data : dict of str to ndarray
+        The requested variables as float64 (SI units as stored).
+    attrs : dict
+        Global attributes (e.g. ``pinion_teeth``, ``gear_teeth``) and per-variable units under
+        ``"units"``.
+
+    Raises
+    ------
+    DataFileError
+        Missing/corrupt file, or no ``time`` coordinate.
+    InputError
+        A requested variable is absent (the message lists the data variables present).
+    """
+    p = _check_path(path)
+    try:
+        import xarray as xr
+
+        ds = xr.open_dataset(p, engine="h5netcdf")
+    except ImportError as exc:
+        raise DataFileError(p, f"reading NetCDF needs xarray and h5netcdf ({exc})") from exc
+    except Exception as exc:  # h5netcdf/h5py raise OSError, ValueError, KeyError...
+        raise DataFileError(p, f"not a readable NetCDF4/HDF5 file ({type(exc).__name__}: "
+                               f"{exc})") from exc
+    try:
+        if "time" not in ds.coords and "time" not in ds.variables:
+            raise DataFileError(p, "no 'time' coordinate: not a geardyn simulation result")
+        missing = [v for v in variables if v not in ds.data_vars]
+        if missing:
+            have = ", ".join(sorted(map(str, ds.data_vars)))
+            raise InputError("signals", missing[0] if len(missing) == 1 else missing,
+                             f"data variables of {p.name}: {have}")
+        try:
+            time = np.asarray(ds["time"].values, dtype=np.float64)
+            data = {v: np.asarray(ds[v].values, dtype=np.float64).reshape(-1)
+                    for v in variables}
+        except (OSError, ValueError, TypeError) as exc:
+            raise DataFileError(p, f"cannot read the data ({exc}); truncated file?") from exc
+        attrs = dict(ds.attrs)
+        attrs["units"] = {v: str(ds[v].attrs.get("units", "")) for v in variables}
+    finally:
+        ds.close()
+    for v, arr in data.items():
+        if arr.shape != time.shape:
+            raise DataFileError(p, f"variable {v!r} has shape {arr.shape}, not the time "
+                                   f"axis {time.shape}")
+    return time, data, attrs

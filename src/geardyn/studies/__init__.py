@@ -1,0 +1,1 @@
+"""Studies: the paper's case study (:mod:`geardyn.studies.paper`) and parameter sweeps."""
