@@ -429,33 +429,35 @@ class DiagnosisResult:
         Kinds: ``tsa``, ``spectrum`` (dB, mesh harmonics marked), ``residual``, ``pwvd_tsa``,
         ``pwvd_residual``, ``demodulation`` and ``analytic``.
         """
+        return dict(self._iter_figures())
+
+    def _iter_figures(self):
+        """Yield ``(stem, Figure)`` one at a time (so writing them holds one in memory)."""
         from . import plots
 
-        figs: dict[str, Any] = {}
         for name, d in self.signals.items():
             stem = _safe(name)
             u = d.unit
-            figs[f"{stem}_tsa"] = plots.plot_tsa(d.tsa, label=name, unit=u)
+            yield f"{stem}_tsa", plots.plot_tsa(d.tsa, label=name, unit=u)
             db = order_spectrum(d.tsa.average, scaling="rms", db=True)
-            figs[f"{stem}_spectrum"] = plots.plot_order_spectrum(db, teeth=self.teeth,
-                                                                 label=name, unit=u)
-            figs[f"{stem}_residual"] = plots.plot_residual(d.residual, label=name, unit=u)
-            figs[f"{stem}_pwvd_tsa"] = plots.plot_pwvd(d.pwvd_tsa, teeth=self.teeth,
-                                                       label=f"TSA of {name}", unit=u)
-            figs[f"{stem}_pwvd_residual"] = plots.plot_pwvd(
+            yield f"{stem}_spectrum", plots.plot_order_spectrum(db, teeth=self.teeth,
+                                                                label=name, unit=u)
+            yield f"{stem}_residual", plots.plot_residual(d.residual, label=name, unit=u)
+            yield f"{stem}_pwvd_tsa", plots.plot_pwvd(d.pwvd_tsa, teeth=self.teeth,
+                                                      label=f"TSA of {name}", unit=u)
+            yield f"{stem}_pwvd_residual", plots.plot_pwvd(
                 d.pwvd_residual, teeth=self.teeth, label=f"residual of {name}", unit=u)
-            figs[f"{stem}_demodulation"] = plots.plot_demodulation(d.demodulation, label=name,
-                                                                   unit=u)
-            figs[f"{stem}_analytic"] = plots.plot_analytic_signal(d.demodulation, label=name,
+            yield f"{stem}_demodulation", plots.plot_demodulation(d.demodulation, label=name,
                                                                   unit=u)
-        return figs
+            yield f"{stem}_analytic", plots.plot_analytic_signal(d.demodulation, label=name,
+                                                                 unit=u)
 
     def write_figures(self, folder, *, dpi: int = 110) -> list[Path]:
         """Write every figure as ``<folder>/<stem>.png`` (atomically); returns the paths."""
         folder = Path(folder)
         folder.mkdir(parents=True, exist_ok=True)
         written = []
-        for stem, fig in self.figures().items():
+        for stem, fig in self._iter_figures():
             target = folder / f"{stem}.png"
             _atomic_write(target, lambda fh, fig=fig: fig.savefig(fh, format="png", dpi=dpi))
             written.append(target)

@@ -257,7 +257,8 @@ def regular_orders(teeth: int, samples_per_rev: int, *, shaft_harmonics: int = 2
     for off in range(-b, b + 1):
         parts.append(mesh + off)
     out = np.unique(np.concatenate(parts).astype(np.int64))
-    return out[(out >= 0) & (out <= nyq)]
+    low = 0 if include_dc else 1  # a sideband reaching order 0 is not the mean
+    return out[(out >= low) & (out <= nyq)]
 
 
 def _n_last(x) -> int:

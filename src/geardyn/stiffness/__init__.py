@@ -22,6 +22,10 @@ def centre_distance_grid(case) -> np.ndarray:
     return np.linspace(s.centre_distance_min, s.centre_distance_max, s.centre_distances)
 
 
+#: Bump when a method's physics or numerics change, so cached maps are rebuilt.
+MODEL_VERSIONS = {"pem": "1", "fe": "1"}
+
+
 def map_inputs(case, method: str, cracked: bool) -> dict:
     """Everything a stiffness map depends on, as plain data (hashed for the cache key)."""
     from .. import __version__
@@ -29,6 +33,7 @@ def map_inputs(case, method: str, cracked: bool) -> dict:
     data = {
         "geardyn": __version__,
         "method": method,
+        "model_version": MODEL_VERSIONS[method],
         "pair": case.pair.model_dump(mode="json"),
         "pinion": {k: getattr(case.pinion, k) for k in ("teeth", "profile_shift", "bore_radius")},
         "gear": {k: getattr(case.gear, k) for k in ("teeth", "profile_shift", "bore_radius")},
@@ -64,13 +69,14 @@ def build_map(case, *, method: str | None = None, cracked: bool = True,
     Returns
     -------
     StiffnessMap
-        ``k_mb`` [N/m] on the case's centre-distance grid over one pinion revolution.
+        ``k_mb`` [N/m] on the case's centre-distance grid over one period: one pinion
+        revolution, or one gear revolution for a crack on the gear (``StiffnessMap.period``).
     """
     from ..cache import cache_key, default_cache
     from ..errors import InputError
 
     method = method or case.stiffness.method
-    if method not in ("pem", "fe"):
+    if method not in MODEL_VERSIONS:
         raise InputError("stiffness.method", method, "'pem' or 'fe'")
     cache = cache or default_cache()
     inputs = map_inputs(case, method, cracked)

@@ -381,10 +381,12 @@ class StiffnessMap:
                                  attrs={"method": "table", **dict(attrs or {})})
 
     # --------------------------------------------------------------- evaluation
-    def arrays(self, variable: str = "k_mb") -> MapArrays:
+    def arrays(self, variable: str = "k_mb", slot: int | None = None) -> MapArrays:
         """The plain arrays for :func:`lookup` (``variable``: ``"k_mb"`` or an ``extra`` name
-        with one value per node)."""
+        with one value per node; ``slot`` picks one column of ``load_share``)."""
         vals = self.k_mb if variable == "k_mb" else self.extra[variable]
+        if slot is not None:
+            vals = vals[..., slot]
         if vals.ndim != 2:
             raise InputError("variable", variable, "a variable with one value per node")
         ddd = float(self.dd[1] - self.dd[0]) if self.dd.size > 1 else 0.0
@@ -392,12 +394,14 @@ class StiffnessMap:
                          np.ascontiguousarray(self.length_a), float(self.mesh_angle),
                          int(self.n_cycles), int(self.n_seg), np.ascontiguousarray(vals))
 
-    def __call__(self, theta, dd=0.0, variable: str = "k_mb") -> np.ndarray:
+    def __call__(self, theta, dd=0.0, variable: str = "k_mb", slot: int | None = None
+                 ) -> np.ndarray:
         """Evaluate the map at pinion angles ``theta`` [rad] and changes ``dd`` [m].
 
         Returns ``k_mb`` [N/m] by default; NaN outside the centre-distance range.
+        ``variable="load_share", slot=k`` gives the share of slot ``k`` (see ``slot_tooth``).
         """
-        arr = self.arrays(variable)
+        arr = self.arrays(variable, slot)
         th, d = np.broadcast_arrays(np.asarray(theta, float), np.asarray(dd, float))
         out = _lookup_many(th.ravel(), d.ravel(), *arr)
         return out.reshape(th.shape) if th.shape else float(out[0])
@@ -458,7 +462,9 @@ class StiffnessMap:
         if self.slot_tooth is not None:
             ds["slot_tooth"] = (("cycle", "slot"), self.slot_tooth,
                                 {"long_name": "pinion tooth of each load-share slot"})
-        ds.attrs.update({k: (json.dumps(v) if isinstance(v, dict | list | tuple) else v)
+        # NetCDF attributes cannot hold containers, booleans or None: store those as JSON text
+        ds.attrs.update({k: (json.dumps(v) if isinstance(v, dict | list | tuple | bool)
+                             or v is None else v)
                          for k, v in self.attrs.items()})
         ds.attrs.update({"mesh_angle": self.mesh_angle, "mesh_angle_units": "rad",
                          "n_cycles": self.n_cycles, "n_seg": self.n_seg,

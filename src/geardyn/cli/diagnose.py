@@ -1,0 +1,67 @@
+"""``geardyn diagnose``: the diagnostic chain on a simulation result or on measured data."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from . import app
+from ._common import ConfigOption, SetOption, console, handle_errors, load_case_from_cli
+
+
+@app.command("diagnose")
+@handle_errors
+def diagnose(
+    file: Annotated[Path, typer.Argument(help="A geardyn simulation (.nc) or measured data "
+                                              "(.csv, .txt, .npy, .npz, .mat).")],
+    config: ConfigOption = None,
+    set_: SetOption = None,
+    out: Annotated[Path, typer.Option("--out", "-o", help="Output folder for metrics.json and "
+                                                          "figures/.")] = Path("geardyn-out/diagnose"),
+    signal: Annotated[list[str] | None, typer.Option(
+        "--signal", help="Signal column/variable (repeatable). Default for a simulation: "
+                         "v_yg, omega_p, transmission_error.", show_default=False)] = None,
+    teeth: Annotated[int | None, typer.Option(
+        "--teeth", help="Teeth on the shaft whose angle is given (default: the simulation's "
+                        "pinion, or the case's pinion for measured data).",
+        show_default=False)] = None,
+    fs: Annotated[float | None, typer.Option("--fs", help="Sampling rate [Hz] of measured data.",
+                                             show_default=False)] = None,
+    time: Annotated[str | None, typer.Option("--time", help="Time column [s] (instead of --fs).",
+                                             show_default=False)] = None,
+    angle: Annotated[str | None, typer.Option("--angle", help="Shaft angle column.",
+                                              show_default=False)] = None,
+    angle_unit: Annotated[str, typer.Option("--angle-unit", help="rad, deg or rev.")] = "rad",
+    tach: Annotated[str | None, typer.Option("--tach", help="Tachometer column (pulse train, or "
+                                                            "pulse times with --tach-times).",
+                                             show_default=False)] = None,
+    tach_times: Annotated[bool, typer.Option("--tach-times", help="The tach column holds pulse "
+                                                                  "times [s].")] = False,
+    pulses_per_rev: Annotated[int, typer.Option("--pulses-per-rev", min=1,
+                                                help="Tachometer pulses per revolution.")] = 1,
+) -> None:
+    """Run TSA, spectra, residual, demodulation, PWVD and condition metrics; write figures and
+    metrics.json into OUT."""
+    from ..diagnostics import diagnose_file
+
+    case = load_case_from_cli(config, set_)
+    d = case.diagnostics
+    is_sim = file.suffix.lower() in (".nc", ".nc4", ".netcdf")
+    if teeth is None and not is_sim:
+        teeth = case.pinion.teeth
+    result = diagnose_file(
+        file, teeth=teeth, signals=signal or None, fs=fs, time=time, angle=angle, tach=tach,
+        tach_column_is_pulse_times=tach_times, pulses_per_rev=pulses_per_rev,
+        angle_unit=angle_unit, samples_per_rev=d.samples_per_rev, harmonic=d.harmonic,
+        bandwidth=d.bandwidth, residual_preset=d.residual_preset)
+    result.write(out)
+    summary = result.to_dict()
+    console.print(f"[green]done[/green]: metrics and figures in {out}/")
+    for name, sig in summary.get("signals", {}).items():
+        k = sig.get("kurtosis", {})
+        console.print(f"  {name}: {sig.get('n_averages')} revolutions averaged; kurtosis of TSA "
+                      f"{k.get('tsa', float('nan')):.4g}, residual {k.get('residual', float('nan')):.4g}"
+                      f", envelope {k.get('envelope', float('nan')):.4g}, PM "
+                      f"{k.get('phase_modulation', float('nan')):.4g}")

@@ -1,0 +1,420 @@
+r"""Loaded contact of the gear pair from the bodies' influence coefficients.
+
+For a pinion angle ``theta`` and a centre distance change ``dd`` (backlash closed by turning the
+pinion, as in Xue & Howard 2018, section 3, with the gear hub fixed and the torque ``T`` on the
+pinion hub) the static problem is
+
+.. math::
+   \sum_k C_{jk} F_k + g_j - a_j\,\Delta\theta = w_j \ge 0,\qquad F_j \ge 0,\qquad w_j F_j = 0,
+   \qquad \sum_k a_k F_k = T / b,
+
+for the candidate tooth pairs ``j`` (per metre of face width ``b``): ``F_j`` the normal contact
+force, ``C = C^{(1)} + C^{(2)} + C^{loc}(F)`` the compliance of the pinion and the gear (FE
+influence coefficients under a reference Hertzian patch, :mod:`.solve`) plus the analytical
+correction of the local Hertzian deformation to the actual contact width, ``g_j`` the unloaded gap,
+``a_j`` the pinion lever arm of the contact force and ``Delta theta`` the rotation of the pinion hub
+(the static transmission error). It is the optimality system of the strictly convex quadratic
+programme ``min 1/2 F^T C F + g^T F`` subject to ``F >= 0``, ``a^T F = T/b``, solved exactly by an
+active-set enumeration (at most five candidates), with a fixed-point iteration on the load-dependent
+local term. Then ``K_t = T / Delta theta`` (secant) and ``k_mb = K_t / r_b1^2`` with the *base*
+radius (traps T5 and T6 of design/stiffness.md).
+
+Kinematics and unloaded gaps
+----------------------------
+Candidate pairs come from :meth:`geardyn.geometry.GearPair.contact_points` (position ``s`` along
+the operating line of action, LOA). Inside the theoretical path ``[s_start, s_end]`` the perfect
+involutes touch (``g = 0``) at roll lengths ``u_1 = s`` and ``u_2 = T_1T_2 - s`` and the force acts
+along the LOA (``a = r_b1``). Beyond it, the tip corner of one gear faces the flank of the other.
+Involutes of one base circle are parallel curves whose normal distance is ``r_b`` times their
+angular offset, so the gap between the corner ``C`` and the mating flank is exact:
+
+* pinion tip corner (``s > s_end``): ``g = u_2(C) + r_b2 (gamma_C - pi) - (T_1T_2 - s)``, with
+  ``u_2(C)`` the length of the tangent from ``C`` to the gear base circle and ``gamma_C`` its
+  tangency angle; the gear is loaded at roll ``u_2(C) - g``, the pinion at its tip, along that
+  tangent (lever arm about the pinion centre computed exactly);
+* gear tip corner (``s < s_start``): the mirror formula with the pinion base circle
+  (``a = r_b1``).
+
+So extended contact under load (before the theoretical start, after the theoretical end) appears
+when the deflection closes these gaps. The corner load is applied to the FE bodies as the patch at
+the tip of the flank, and its local term uses the involute curvatures (a sharp corner has no
+Hertzian solution; real tips are rounded).
+
+References
+----------
+Xue, S. & Howard, I. (2018), Mech. Syst. Signal Process., section 3.
+Johnson, K. L. (1985). Contact Mechanics, eq. 5.36 (approach of cylinders in plane strain).
+Vedmar, L. (1981). On the design of external involute helical gears. PhD thesis, Lund.
+Conry, T. F. & Seireg, A. (1971). A mathematical programming method for design of elastic bodies
+in contact. J. Appl. Mech. 38:387-392.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.interpolate import CubicSpline, RectBivariateSpline
+
+from ...errors import NumericalError
+from .solve import BodyInfluence
+
+__all__ = ["Candidates", "candidates", "BodyCompliance", "solve_compatibility",
+           "ContactResult", "PairContactModel"]
+
+PATH, PINION_TIP, GEAR_TIP = 0, 1, 2
+
+
+@dataclass(frozen=True)
+class Candidates:
+    """Candidate contacts of the tooth pairs near the mesh at one pinion angle.
+
+    Attributes
+    ----------
+    pair, pinion_tooth, gear_tooth : ndarray of int
+        Pair index ``n`` and tooth numbers (see :mod:`geardyn.geometry`).
+    s : ndarray
+        Position of the pair along the operating LOA [m].
+    kind : ndarray of int
+        0 on the theoretical path, 1 pinion tip corner (beyond the end), 2 gear tip corner
+        (before the start).
+    u1, u2 : ndarray
+        Roll lengths of the load points on the pinion and the gear flanks [m].
+    gap : ndarray
+        Unloaded normal gap [m] (0 on the path).
+    arm : ndarray
+        Lever arm of the contact force about the pinion centre [m].
+    radius : ndarray
+        Relative radius of curvature ``rho_1 rho_2 / (rho_1 + rho_2)`` for the Hertz width [m].
+    """
+
+    pair: np.ndarray
+    pinion_tooth: np.ndarray
+    gear_tooth: np.ndarray
+    s: np.ndarray
+    kind: np.ndarray
+    u1: np.ndarray
+    u2: np.ndarray
+    gap: np.ndarray
+    arm: np.ndarray
+    radius: np.ndarray
+
+
+def _wrap(a):
+    return (np.asarray(a) + math.pi) % (2 * math.pi) - math.pi
+
+
+def candidates(pair, theta: float, dd: float, margin: float = 0.35) -> Candidates:
+    """Candidate contacts, their load points, gaps and lever arms at ``(theta, dd)``.
+
+    Parameters
+    ----------
+    pair : geardyn.geometry.GearPair
+    theta : float
+        Pinion angle [rad] (geometry.py convention; backlash closed).
+    dd : float
+        Centre distance change [m].
+    margin : float
+        Candidates up to ``margin`` base pitches outside the theoretical path.
+
+    Returns
+    -------
+    Candidates
+    """
+    cp = pair.contact_points(theta, dd, margin=margin)
+    op = pair.operating(dd, check=False)
+    rb1, rb2 = pair.pinion.base_radius, pair.gear.base_radius
+    t1t2 = op.t1t2
+    o2 = np.array([rb1 + rb2, t1t2])
+    ua1 = math.sqrt(pair.pinion.tip_radius ** 2 - rb1 ** 2)
+    ua2 = math.sqrt(pair.gear.tip_radius ** 2 - rb2 ** 2)
+    s = cp.s
+    n = s.size
+    kind = np.where(s > op.s_end, PINION_TIP, np.where(s < op.s_start, GEAR_TIP, PATH))
+    u1 = s.copy()
+    u2 = t1t2 - s
+    gap = np.zeros(n)
+    arm = np.full(n, rb1)
+    for k in range(n):
+        if kind[k] == PINION_TIP:
+            beta = (s[k] - ua1) / rb1
+            c = rb1 * np.array([math.cos(beta), math.sin(beta)]) \
+                + ua1 * np.array([-math.sin(beta), math.cos(beta)])
+            v = c - o2
+            r = math.hypot(*v)
+            gam = math.atan2(v[1], v[0]) - math.acos(rb2 / r)
+            lam = math.sqrt(r * r - rb2 * rb2)
+            g = lam + rb2 * float(_wrap(gam - math.pi)) - (t1t2 - s[k])
+            gap[k] = g
+            u1[k] = ua1
+            u2[k] = lam - g
+            t2 = o2 + rb2 * np.array([math.cos(gam), math.sin(gam)])
+            e = np.array([-math.sin(gam), math.cos(gam)])
+            arm[k] = abs(t2[0] * e[1] - t2[1] * e[0])
+        elif kind[k] == GEAR_TIP:
+            gn = t1t2 - s[k]
+            gam = math.pi + (gn - ua2) / rb2
+            c = o2 + rb2 * np.array([math.cos(gam), math.sin(gam)]) \
+                + ua2 * np.array([-math.sin(gam), math.cos(gam)])
+            r = math.hypot(*c)
+            beta = math.atan2(c[1], c[0]) - math.acos(rb1 / r)
+            lam = math.sqrt(r * r - rb1 * rb1)
+            g = lam + rb1 * float(_wrap(beta)) - s[k]
+            gap[k] = g
+            u1[k] = lam - g
+            u2[k] = ua2
+    rho1 = np.clip(u1, 1e-9, None)
+    rho2 = np.clip(u2, 1e-9, None)
+    return Candidates(pair=cp.pair, pinion_tooth=cp.pinion_tooth, gear_tooth=cp.gear_tooth, s=s,
+                      kind=kind, u1=u1, u2=u2, gap=gap, arm=arm,
+                      radius=rho1 * rho2 / (rho1 + rho2))
+
+
+class BodyCompliance:
+    """Interpolated influence coefficients of one body between any two load points.
+
+    Parameters
+    ----------
+    influence : BodyInfluence
+        Healthy body (loaded on tooth 0 only; cyclic symmetry gives the other teeth) or cracked
+        body (loaded on every refined tooth; model tooth 0 cracked).
+    teeth : int
+        Number of teeth of the gear.
+    """
+
+    def __init__(self, influence: BodyInfluence, teeth: int):
+        self.inf = influence
+        self.z = teeth
+        u = influence.u
+        self.u_min, self.u_max = float(u[0]), float(u[-1])
+        self.cyclic = influence.load_offsets == (0,)
+        self._self: dict[int, CubicSpline] = {}
+        self._cross: dict[tuple[int, int], RectBivariateSpline] = {}
+        ro = influence.read_offsets
+        for a, i in enumerate(influence.load_offsets):
+            b = ro.index(i)
+            self._self[i] = CubicSpline(u, np.diag(influence.H[a, b]))
+            for b, j in enumerate(ro):
+                if j != i:
+                    self._cross[(i, j)] = RectBivariateSpline(u, u, influence.H[a, b])
+
+    def covers(self, offset: int) -> bool:
+        """Whether model tooth ``offset`` is loaded in this body's model (cracked bodies)."""
+        return offset in self.inf.load_offsets
+
+    def __call__(self, load: int, u_load: float, read: int, u_read: float) -> float:
+        """Compliance [m^2/N]: displacement at ``u_read`` on model tooth ``read`` per unit load at
+        ``u_load`` on model tooth ``load`` (0 if the teeth are farther apart than the model)."""
+        ul = min(max(u_load, self.u_min), self.u_max)
+        ur = min(max(u_read, self.u_min), self.u_max)
+        if self.cyclic:
+            read, load = read - load, 0
+        if read == load:
+            return float(self._self[load](ul))
+        f = self._cross.get((load, read))
+        if f is None:
+            return 0.0
+        return float(f(ur, ul)[0, 0])
+
+
+@dataclass(frozen=True)
+class ContactResult:
+    """Loaded contact at one position (per metre of face width).
+
+    Attributes
+    ----------
+    force : ndarray
+        Normal contact force of each candidate per unit width [N/m].
+    rotation : float
+        Pinion hub rotation ``Delta theta`` under the torque [rad] (static transmission error).
+    separation : ndarray
+        Loaded gap of each candidate [m] (0 where in contact).
+    iterations : int
+        Fixed-point iterations of the local Hertz term.
+    """
+
+    force: np.ndarray
+    rotation: float
+    separation: np.ndarray
+    iterations: int
+
+
+def _qp(c: np.ndarray, g: np.ndarray, a: np.ndarray, torque: float,
+        first: np.ndarray | None = None) -> tuple[np.ndarray, float, np.ndarray]:
+    """Exact active-set enumeration of ``min 1/2 F'CF + g'F, F >= 0, a'F = torque``."""
+    n = g.size
+    scale_f = torque / a.max()
+    orders: list[tuple[int, ...]] = []
+    if first is not None and first.any():
+        orders.append(tuple(np.nonzero(first)[0]))
+    for m in range(1, n + 1):
+        orders += [s for s in itertools.combinations(range(n), m) if s not in orders]
+    best = None
+    for sset in orders:
+        idx = np.asarray(sset)
+        k = idx.size
+        mat = np.zeros((k + 1, k + 1))
+        mat[:k, :k] = c[np.ix_(idx, idx)]
+        mat[:k, k] = -a[idx]
+        mat[k, :k] = a[idx]
+        rhs = np.concatenate([-g[idx], [torque]])
+        try:
+            sol = np.linalg.solve(mat, rhs)
+        except np.linalg.LinAlgError:
+            continue
+        f = np.zeros(n)
+        f[idx] = sol[:k]
+        dth = sol[k]
+        if np.any(f < -1e-10 * scale_f):
+            continue
+        w = c @ f + g - dth * a
+        tol = 1e-9 * max(dth * a.max(), 1e-30)
+        if np.any(np.delete(w, idx) < -tol):
+            continue
+        f = np.clip(f, 0.0, None)
+        w[idx] = 0.0
+        best = (f, float(dth), np.clip(w, 0.0, None))
+        break
+    if best is None:
+        raise NumericalError("no solution of the contact compatibility problem",
+                             state={"candidates": n})
+    return best
+
+
+def solve_compatibility(c0: np.ndarray, gap: np.ndarray, arm: np.ndarray, torque: float,
+                        local=None, *, tol: float = 1e-10, max_iter: int = 60) -> ContactResult:
+    """Contact forces and hub rotation from compliances, gaps and lever arms.
+
+    Parameters
+    ----------
+    c0 : ndarray, shape (n, n)
+        Compliance matrix at the reference patch width [m^2/N] (per unit width, symmetric).
+    gap : ndarray, shape (n,)
+        Unloaded gaps [m].
+    arm : ndarray, shape (n,)
+        Pinion lever arms [m].
+    torque : float
+        Pinion torque per unit width [N m/m].
+    local : callable, optional
+        ``local(F) -> (n,)`` extra diagonal compliance of the local contact at forces ``F``
+        [m^2/N]; solved by fixed-point iteration on the secant compliance.
+
+    Returns
+    -------
+    ContactResult
+    """
+    gap = np.asarray(gap, float)
+    arm = np.asarray(arm, float)
+    first = gap <= 0
+    f, dth, w = _qp(c0, gap, arm, torque, first)
+    it = 0
+    if local is not None:
+        for it in range(1, max_iter + 1):
+            c = c0 + np.diag(local(f))
+            f_new, dth_new, w = _qp(c, gap, arm, torque, f > 0)
+            done = abs(dth_new - dth) <= tol * abs(dth_new) and \
+                np.max(np.abs(f_new - f)) <= tol * 1e3 * np.max(f_new)
+            f, dth = f_new, dth_new
+            if done:
+                break
+        else:
+            raise NumericalError("local contact iteration did not converge",
+                                 state={"rotation": dth})
+    return ContactResult(force=f, rotation=dth, separation=w, iterations=it)
+
+
+class PairContactModel:
+    """The gear pair's compliance and loaded contact at any ``(theta, dd)``.
+
+    Parameters
+    ----------
+    pair : geardyn.geometry.GearPair
+    pinion, gear : BodyCompliance
+        Healthy bodies.
+    cracked : BodyCompliance, optional
+        The cracked body (model tooth 0 is the cracked tooth).
+    crack_gear : {"pinion", "gear"}
+    crack_tooth : int
+        Cracked tooth number (mesh order).
+    material_pinion, material_gear : ElasticMaterial-like with ``plane_modulus``
+    half_width : float
+        Reference patch half-width of the influence coefficients [m].
+    """
+
+    def __init__(self, pair, pinion: BodyCompliance, gear: BodyCompliance, *,
+                 cracked: BodyCompliance | None = None, crack_gear: str = "pinion",
+                 crack_tooth: int = 0, plane_modulus: tuple[float, float],
+                 half_width: float, local: bool = True):
+        self.pair = pair
+        self.pinion = pinion
+        self.gear = gear
+        self.cracked = cracked
+        self.crack_gear = crack_gear
+        self.crack_tooth = int(crack_tooth)
+        self.e1, self.e2 = plane_modulus
+        self.half_width = half_width
+        self.estar = 1.0 / (1.0 / self.e1 + 1.0 / self.e2)
+        self.local_enabled = local
+
+    # model tooth of a real tooth: pinion teeth follow each other clockwise in the body model
+    # (model offsets run counter-clockwise), gear teeth counter-clockwise.
+    def _wrap(self, d: int, z: int) -> int:
+        return int((d + z // 2) % z - z // 2)
+
+    def model_offset(self, which: str, tooth: int) -> int:
+        """Model tooth of a real tooth: relative to the cracked tooth on the cracked gear, else to
+        tooth 0. Pinion teeth follow each other clockwise in the body model (whose offsets run
+        counter-clockwise), gear teeth counter-clockwise."""
+        z = self.pair.pinion.teeth if which == "pinion" else self.pair.gear.teeth
+        sign = -1 if which == "pinion" else 1
+        ref = self.crack_tooth if (self.cracked is not None and which == self.crack_gear) else 0
+        return sign * self._wrap(int(tooth) - ref, z)
+
+    def involves_crack(self, cand: Candidates) -> bool:
+        """Whether any candidate tooth is within the cracked body's refined teeth."""
+        if self.cracked is None:
+            return False
+        teeth = cand.pinion_tooth if self.crack_gear == "pinion" else cand.gear_tooth
+        return any(self.cracked.covers(self.model_offset(self.crack_gear, int(t)))
+                   for t in teeth)
+
+    def _side(self, which: str, teeth: np.ndarray, u: np.ndarray) -> np.ndarray:
+        n = teeth.size
+        out = np.zeros((n, n))
+        healthy = self.pinion if which == "pinion" else self.gear
+        cracked = self.cracked if which == self.crack_gear else None
+        m = [self.model_offset(which, int(t)) for t in teeth]
+        for j in range(n):
+            for k in range(n):
+                if cracked is not None and cracked.covers(m[k]) and cracked.covers(m[j]):
+                    out[j, k] = cracked(m[k], u[k], m[j], u[j])
+                else:
+                    z = self.pair.pinion.teeth if which == "pinion" else self.pair.gear.teeth
+                    out[j, k] = healthy(0, u[k], self._wrap(m[j] - m[k], z), u[j])
+        # Maxwell-Betti: the patch-to-point coefficients are symmetric up to discretisation
+        return 0.5 * (out + out.T)
+
+    def compliance(self, cand: Candidates) -> np.ndarray:
+        """Compliance matrix of the candidates at the reference patch width [m^2/N per m]."""
+        return self._side("pinion", cand.pinion_tooth, cand.u1) + \
+            self._side("gear", cand.gear_tooth, cand.u2)
+
+    def local_term(self, cand: Candidates, force_per_width: np.ndarray) -> np.ndarray:
+        """Analytical change of the contact approach from the reference patch to the actual Hertz
+        width, per unit force [m^2/N]: ``-(2/pi)(1/E1' + 1/E2') ln(b/b_ref)`` with
+        ``b = sqrt(4 F' R / (pi E*))`` (Johnson 1985, eq. 5.36)."""
+        f = np.maximum(np.asarray(force_per_width, float), 1e-9)
+        b = np.sqrt(4 * f * cand.radius / (math.pi * self.estar))
+        return -(2 / math.pi) * (1 / self.e1 + 1 / self.e2) * np.log(b / self.half_width)
+
+    def solve(self, theta: float, dd: float, torque_per_width: float,
+              margin: float = 0.35) -> tuple[Candidates, ContactResult]:
+        """Candidates and loaded contact at ``(theta, dd)`` for the pinion torque per unit width
+        [N m/m]."""
+        cand = candidates(self.pair, theta, dd, margin=margin)
+        c0 = self.compliance(cand)
+        local = (lambda f: self.local_term(cand, f)) if self.local_enabled else None
+        res = solve_compatibility(c0, cand.gap, cand.arm, torque_per_width, local)
+        return cand, res

@@ -1,0 +1,75 @@
+"""``geardyn stiffness`` as a user runs it: files, units, summary, errors."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+
+import pytest
+import xarray as xr
+
+GEARDYN = [sys.executable, "-m", "geardyn"]
+SMALL = ["--set", "stiffness.centre_distances=6", "--set", "stiffness.nodes_per_segment=8"]
+
+
+def run(*args, cache):
+    env = {**os.environ, "GEARDYN_CACHE_DIR": str(cache)}
+    return subprocess.run(GEARDYN + list(args), capture_output=True, text=True, env=env,
+                          timeout=300)
+
+
+def test_stiffness_writes_maps_and_figures(tmp_path):
+    out = tmp_path / "out"
+    r = run("stiffness", "--method", "pem", "--out", str(out), *SMALL, cache=tmp_path / "c")
+    assert r.returncode == 0, r.stderr
+    for name in ("stiffness_healthy.nc", "stiffness_cracked.nc", "fig5_stiffness.png",
+                 "fig5_load_sharing.png", "fig6_crack.png"):
+        assert (out / name).stat().st_size > 1000, name
+    assert "mean K_t" in r.stdout and "+1.00" in r.stdout
+    assert "Sainsot" in r.stderr  # the paper's theta_f = 0.131 rad is outside the fitted range
+    with xr.open_dataset(out / "stiffness_cracked.nc", engine="h5netcdf") as ds:
+        assert ds["k_mb"].attrs["units"] == "N/m"
+        assert ds["torsional_stiffness"].attrs["units"] == "N m/rad"
+        assert ds.sizes["centre_distance_change"] == 6
+        assert ds.attrs["method"] == "pem"
+        healthy_min = float(xr.open_dataset(out / "stiffness_healthy.nc",
+                                            engine="h5netcdf")["k_mb"].min())
+        assert float(ds["k_mb"].min()) < healthy_min
+    # a second run loads the maps from the cache and writes the same files
+    again = run("stiffness", "--out", str(tmp_path / "out2"), *SMALL, cache=tmp_path / "c")
+    assert again.returncode == 0, again.stderr
+    with xr.open_dataset(out / "stiffness_healthy.nc", engine="h5netcdf") as a, \
+            xr.open_dataset(tmp_path / "out2" / "stiffness_healthy.nc", engine="h5netcdf") as b:
+        assert (a["k_mb"].values == b["k_mb"].values).all()
+
+
+def _invoke(args, cache):
+    """In process (typer's CliRunner): fast, same command function."""
+    from typer.testing import CliRunner
+
+    from geardyn.cli import app
+
+    return CliRunner().invoke(app, args, env={"GEARDYN_CACHE_DIR": str(cache)})
+
+
+def test_stiffness_without_a_crack(tmp_path):
+    out = tmp_path / "out"
+    r = _invoke(["stiffness", "--out", str(out), "--set", "crack.enabled=false", *SMALL],
+                tmp_path / "c")
+    assert r.exit_code == 0, r.output
+    assert (out / "stiffness_healthy.nc").exists() and (out / "fig5_stiffness.png").exists()
+    assert not (out / "stiffness_cracked.nc").exists()
+    assert "no enabled crack" in r.output
+
+
+@pytest.mark.parametrize(("args", "words"), [
+    (["--method", "magic"], "--method"),
+    (["--set", "crack.depth=40mm"], "crack.depth"),
+    (["--set", "stiffness.centre_distance_max=6mm"], "centre_distance_change"),
+])
+def test_bad_input_exits_2(tmp_path, args, words):
+    r = _invoke(["stiffness", "--out", str(tmp_path / "o"), *SMALL, *args], tmp_path / "c")
+    assert r.exit_code == 2, r.output
+    assert words in r.output
+    assert "Traceback" not in r.output
