@@ -4,6 +4,7 @@ Stages run in order, each adding to the summary and to the output folder:
 
 1. ``geometry``: the pair at its design centre distance, at the paper's FE centre distances
    (+0.5, +1.0 mm) and at the static operating point under the input torque (eq. 4).
+2. ``stiffness``: the mesh stiffness maps K(theta, d), healthy and with the crack (Figs. 5, 6).
 
 Later stages (stiffness maps, model I / II simulations, diagnostics, the HTML report) are added to
 this same pipeline.
@@ -16,6 +17,8 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
+
+import numpy as np
 
 from ..config import Case, case_to_toml, paper_case
 from ..geometry import geometry_summary, static_operating_point
@@ -56,6 +59,17 @@ class StudyResult:
     summary: dict = field(default_factory=dict)
     stages: list[str] = field(default_factory=list)
     seconds: dict[str, float] = field(default_factory=dict)
+    maps: dict = field(default_factory=dict)
+    figures: dict = field(default_factory=dict)
+    notes: list[str] = field(default_factory=list)
+    progress: Progress | None = None
+
+    def sub_progress(self, stage: str) -> Callable[[int, int], None] | None:
+        """A ``progress(done, total)`` callback reporting under ``stage``."""
+        if self.progress is None:
+            return None
+        cb = self.progress
+        return lambda done, total: cb(stage, done, total)
 
 
 def _validation_row(quantity: str, paper: float, geardyn: float, tolerance: float,
@@ -105,8 +119,41 @@ def geometry_stage(case: Case, out: Path, result: StudyResult) -> None:
     ]
 
 
+def stiffness_stage(case: Case, out: Path, result: StudyResult) -> None:
+    """Healthy and cracked stiffness maps (cached), NetCDF files and the Figs. 5-6 analogues."""
+    import json
+    import warnings
+
+    from ..stiffness import build_map
+    from ..stiffness.plots import crack_angle, fig_crack, fig_load_sharing, fig_stiffness
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # the maps record their warnings in attrs (read below)
+        healthy = build_map(case, cracked=False, progress=result.sub_progress("stiffness (healthy)"))
+        cracked = build_map(case, cracked=True, progress=result.sub_progress("stiffness (cracked)"))
+    for m in (healthy, cracked):
+        w = m.attrs.get("warnings", "[]")
+        for text in (json.loads(w) if isinstance(w, str) else list(w)):
+            if text not in result.notes:
+                result.notes.append(text)
+    result.maps = {"healthy": healthy, "cracked": cracked}
+    healthy.to_netcdf(out / "stiffness_healthy.nc")
+    cracked.to_netcdf(out / "stiffness_cracked.nc")
+    result.figures["fig5_stiffness"] = fig_stiffness(healthy)
+    result.figures["fig5_load_sharing"] = fig_load_sharing(healthy)
+    if case.crack is not None and case.crack.enabled:
+        result.figures["fig6_crack"] = fig_crack(healthy, cracked)
+        result.summary["crack_angle_in_stiffness_deg"] = math.degrees(
+            crack_angle(healthy, cracked, 0.0))
+    th = np.linspace(0.0, healthy.period, 4096, endpoint=False)
+    result.summary["mean_mesh_stiffness_N_per_m"] = {
+        f"{dd * 1e3:+.1f}mm": float(np.mean(healthy(th, dd))) for dd in (0.0, 0.5e-3, 1.0e-3)
+        if healthy.covers(dd)}
+
+
 STAGES: list[tuple[str, Callable[[Case, Path, StudyResult], None]]] = [
     ("geometry", geometry_stage),
+    ("stiffness", stiffness_stage),
 ]
 
 
@@ -137,7 +184,7 @@ def run_paper_study(case: Case | None = None, out: str | Path = "geardyn-out", *
         case = case.with_overrides({"stiffness.method": stiffness})
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    result = StudyResult(out=out)
+    result = StudyResult(out=out, progress=progress)
     result.summary.update({"case": case.name, "quick": quick,
                            "stiffness_method": case.stiffness.method, "complete": False})
     write_text_atomic(out / "case.toml", case_to_toml(case))
