@@ -41,7 +41,8 @@ def simulate(
         show_default=False)] = None,
 ) -> None:
     """Simulate the gear pair (Newmark, paper section 4) and write the record to OUT."""
-    from ..dynamics import save_mat, save_netcdf, simulate as run_simulation, summary
+    from ..dynamics import save_mat, save_netcdf, summary
+    from ..dynamics import simulate as run_simulation
     from ..errors import InputError, NumericalError
     from ..stiffness import build_map
 

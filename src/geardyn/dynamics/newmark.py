@@ -1,0 +1,495 @@
+r"""Time integration of model I / model II (Xue & Howard 2018, section 4 and Fig. 7).
+
+:func:`simulate` runs a case: static equilibrium at the steady speed, ``settle_time`` discarded,
+``record_time`` recorded every ``decimation``-th step, all inside the compiled kernel of
+:mod:`geardyn.dynamics._kernel` called in chunks (progress is reported between chunks; there is
+no Python call per step). :func:`make_setup`, :func:`initial_state` and :func:`run_steps` expose
+the same kernel for any 6-DOF ``M``, ``K0``, ``C``, ``g`` (the tests use them for single-DOF
+oscillators with closed-form solutions).
+
+The algorithm, the stiffness evaluation point, the model II iteration and the tooth separation
+rule are described in :mod:`geardyn.dynamics._kernel`.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import InputError, NumericalError
+from ..stiffness.map import MapArrays, StiffnessMap
+from . import _kernel as K
+from .model import (
+    DynamicModel,
+    StaticState,
+    TorqueLaw,
+    check_time_step,
+    max_time_step,
+    static_equilibrium,
+)
+
+__all__ = ["simulate", "make_setup", "initial_state", "run_steps", "KernelSetup",
+           "CHUNK_STEPS", "CITATIONS"]
+
+#: Steps per kernel call (progress is reported between calls).
+CHUNK_STEPS = 20_000
+
+CITATIONS = (
+    "Xue & Howard 2018, Mech. Syst. Signal Process., Dynamic modelling of flexibly supported "
+    "gears using iterative convergence of tooth mesh stiffness (model, eqs. 4-17, Fig. 7)",
+    "Newmark 1959, J. Eng. Mech. Div. ASCE 85(3):67-94 (average acceleration method)",
+    "Hilber, Hughes & Taylor 1977, Earthq. Eng. Struct. Dyn. 5:283-292 (HHT-alpha)",
+    "Chaari, Bartelmus, Zimroz, Fakhfakh & Haddar 2012, Shock Vib. 19(4):635-652 "
+    "(motor/load inertias and coupling stiffness defaults)",
+)
+
+
+@dataclass
+class KernelSetup:
+    """Everything the kernel needs, as arrays (see :func:`make_setup`)."""
+
+    M: np.ndarray
+    K0: np.ndarray
+    C: np.ndarray
+    Q0: np.ndarray
+    Sinv: np.ndarray
+    SK: np.ndarray
+    SC: np.ndarray
+    sQ: np.ndarray
+    u: np.ndarray
+    g: np.ndarray
+    fp: np.ndarray
+    ip: np.ndarray
+    map_arrays: MapArrays
+    in_table: tuple[np.ndarray, np.ndarray]
+    out_table: tuple[np.ndarray, np.ndarray]
+
+    def args(self) -> tuple:
+        """The kernel arguments after ``fail``."""
+        m = self.map_arrays
+        return (self.M, self.K0, self.C, self.Q0, self.Sinv, self.SK, self.SC, self.sQ, self.u,
+                self.g, self.fp, self.ip,
+                m.dd0, m.ddd, m.phase_a, m.length_a, m.mesh_angle, m.n_cycles, m.n_seg, m.values,
+                self.in_table[0], self.in_table[1], self.out_table[0], self.out_table[1])
+
+    @property
+    def dt(self) -> float:
+        """Time step [s]."""
+        return float(self.fp[K.FP_DT])
+
+
+def make_setup(M, K0, C, g, Q0, stiffness_map: StiffnessMap | MapArrays, *, dt: float,
+               model: str = "I", evaluation: str = "predictor", integrator: str = "newmark",
+               hht_alpha: float = 0.0, q_mb: float = 0.0, rsum: float = 1.0, t1t2: float = 0.0,
+               d0: float | None = None, tolerance: float = 1e-7, rtol: float = 1e-9,
+               max_iterations: int = 50, speed: float = 0.0, p_lim: float = math.inf,
+               y_lim: float = math.inf, separation: bool = True,
+               input_law: TorqueLaw | None = None, output_law: TorqueLaw | None = None,
+               input_speed: float = 0.0, output_speed: float = 0.0) -> KernelSetup:
+    r"""Arrays for the kernel from a general 6-DOF system in deviation coordinates.
+
+    The system is ``M z'' + C z' + K0 z + N g = Q0 + q(z')``, ``N = h (k p + q_mb p')``,
+    ``p = g^T z``, with ``k = map(theta, dd)``, ``theta = fmod(n speed dt, period) + z[2]`` and
+    ``dd = hypot(rsum, t1t2 + z[3] - z[1]) - d0`` (model II) or 0 (model I).
+
+    Parameters
+    ----------
+    M, K0, C : array_like, shape (6, 6)
+        Mass, stiffness and damping (``C`` includes the load-law linearisation) [SI].
+    g : array_like, shape (6,)
+        Mesh vector.
+    Q0 : array_like, shape (6,)
+        Constant forcing [N, N m].
+    stiffness_map : StiffnessMap or MapArrays
+    dt : float
+        Time step [s].
+    model : {"I", "II"}
+    evaluation : {"predictor", "start"}
+    integrator : {"newmark", "hht"}
+    hht_alpha : float
+        HHT alpha in [-1/3, 0] (``integrator="hht"``).
+    q_mb : float
+        Mesh damping [N s/m].
+    rsum, t1t2, d0 : float
+        ``r_b1 + r_b2``, the design ``T1T2`` and the design centre distance [m] (eq. 4); ``d0``
+        defaults to ``hypot(rsum, t1t2)``.
+    tolerance, rtol, max_iterations
+        Model II stopping rules (``|b1 - b2| < tolerance`` [m], relative acceleration update,
+        iterations before failing).
+    speed : float
+        Reference pinion speed [rad/s] (phase of the map angle).
+    p_lim, y_lim : float
+        Sanity limits on ``|p|`` and ``|z[1]|``, ``|z[3]|`` [m].
+    separation : bool
+        Eq. 15 (``h = 0`` when the teeth separate); ``False`` keeps ``h = 1``.
+    input_law, output_law : TorqueLaw, optional
+        Laws whose nonlinear remainder the kernel adds to ``Q0`` (affine laws need none: their
+        constant is in ``Q0`` and their slope in ``C``).
+    input_speed, output_speed : float
+        Reference speeds of DOF 0 and 5 [rad/s] (the laws are linearised there).
+    """
+    if model not in ("I", "II"):
+        raise InputError("simulation.model", model, "'I' or 'II'")
+    if evaluation not in ("predictor", "start"):
+        raise InputError("simulation.stiffness_evaluation", evaluation, "'predictor' or 'start'")
+    if integrator not in ("newmark", "hht"):
+        raise InputError("simulation.integrator", integrator, "'newmark' or 'hht'")
+    al = float(hht_alpha) if integrator == "hht" else 0.0
+    if not -1.0 / 3.0 <= al <= 0.0:
+        raise InputError("simulation.hht_alpha", hht_alpha, "a value in [-1/3, 0]")
+    beta, gamma = (1.0 - al) ** 2 / 4.0, 0.5 - al
+    M, K0, C = (np.ascontiguousarray(a, dtype=float) for a in (M, K0, C))
+    g, Q0 = np.ascontiguousarray(g, dtype=float), np.ascontiguousarray(Q0, dtype=float)
+    S = M + (1.0 + al) * (gamma * dt * C + beta * dt * dt * K0)
+    Sinv = np.ascontiguousarray(np.linalg.inv(S))
+    u = Sinv @ g
+    arrays = stiffness_map.arrays() if isinstance(stiffness_map, StiffnessMap) else stiffness_map
+    laws = []
+    for law, w in ((input_law, input_speed), (output_law, output_speed)):
+        law = law or TorqueLaw("constant", 0.0)
+        p0, p1, p2 = law.params()
+        laws.append((law, (p0, p1, p2, w, float(law.torque(w)), law.slope(w))))
+    fp = np.zeros(K.N_FP)
+    fp[K.FP_DT], fp[K.FP_BETA], fp[K.FP_GAMMA], fp[K.FP_ALPHA] = dt, beta, gamma, al
+    fp[K.FP_QMB], fp[K.FP_RSUM], fp[K.FP_T1T2] = q_mb, rsum, t1t2
+    fp[K.FP_D0] = math.hypot(rsum, t1t2) if d0 is None else d0
+    fp[K.FP_TOL], fp[K.FP_RTOL], fp[K.FP_HSTEP] = tolerance, rtol, speed * dt
+    fp[K.FP_PLIM], fp[K.FP_YLIM] = p_lim, y_lim
+    fp[K.FP_SIGMA] = g @ u
+    fp[K.FP_UNORM] = math.sqrt(u @ M @ u)
+    fp[K.FP_IN_P0:K.FP_IN_SLOPE + 1] = laws[0][1]
+    fp[K.FP_OUT_P0:K.FP_OUT_SLOPE + 1] = laws[1][1]
+    fp[K.FP_TSCALE] = max(abs(laws[0][1][4]), abs(laws[1][1][4]), 1e-300)
+    ip = np.zeros(K.N_IP, dtype=np.int64)
+    ip[K.IP_MODEL] = 2 if model == "II" else 1
+    ip[K.IP_EVAL] = 1 if evaluation == "start" else 0
+    ip[K.IP_MAXIT] = int(max_iterations)
+    ip[K.IP_SEP] = int(bool(separation))
+    ip[K.IP_INLAW], ip[K.IP_OUTLAW] = laws[0][0].code, laws[1][0].code
+    ip[K.IP_IN_NL], ip[K.IP_OUT_NL] = int(laws[0][0].nonlinear), int(laws[1][0].nonlinear)
+    return KernelSetup(M=M, K0=K0, C=C, Q0=Q0, Sinv=Sinv, SK=np.ascontiguousarray(Sinv @ K0),
+                       SC=np.ascontiguousarray(Sinv @ C), sQ=np.ascontiguousarray(Sinv @ Q0),
+                       u=np.ascontiguousarray(u), g=g, fp=fp, ip=ip, map_arrays=arrays,
+                       in_table=laws[0][0].table(), out_table=laws[1][0].table())
+
+
+def _q_remainders(setup: KernelSetup, v: np.ndarray) -> tuple[float, float]:
+    fp, ip = setup.fp, setup.ip
+    out = []
+    for nl, law, base, tab, sign, dz in (
+            (ip[K.IP_IN_NL], ip[K.IP_INLAW], K.FP_IN_P0, setup.in_table, 1.0, v[0]),
+            (ip[K.IP_OUT_NL], ip[K.IP_OUTLAW], K.FP_OUT_P0, setup.out_table, -1.0, v[5])):
+        if not nl:
+            out.append(0.0)
+            continue
+        p0, p1, p2, wref, tref, slope = fp[base:base + 6]
+        t = K._law_torque_py(law, p0, p1, p2, tab[0], tab[1], wref + dz)
+        out.append(sign * (t - tref - slope * dz))
+    return out[0], out[1]
+
+
+def initial_state(setup: KernelSetup, z0, v0=None, step: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    """State arrays for the kernel at step ``step`` with deviations ``z0``, velocities ``v0``.
+
+    The acceleration comes from the equations of motion (zero at a static equilibrium).
+
+    Returns
+    -------
+    st : ndarray, shape (N_STATE,)
+    ist : ndarray of int64, shape (2,)
+        ``[step, recorded flag]``.
+    """
+    from ..stiffness.map import lookup_reference
+
+    z0 = np.asarray(z0, dtype=float)
+    v0 = np.zeros(6) if v0 is None else np.asarray(v0, dtype=float)
+    fp, ip, g = setup.fp, setup.ip, setup.g
+    m = setup.map_arrays
+    period = m.n_cycles * m.mesh_angle
+    d = math.hypot(fp[K.FP_RSUM], fp[K.FP_T1T2] + z0[3] - z0[1])
+    dd = d - fp[K.FP_D0] if ip[K.IP_MODEL] == 2 else 0.0
+    theta = np.fmod(step * fp[K.FP_HSTEP], period) + z0[2]
+    k0 = float(lookup_reference(np.array(theta), np.array(dd), m))
+    if np.isnan(k0):
+        raise InputError("stiffness_map", f"range [{m.dd0:.6g}, "
+                         f"{m.dd0 + m.ddd * (m.values.shape[0] - 1):.6g}] m",
+                         f"a map covering the initial centre distance change {dd:.6g} m")
+    p0, pd0 = g @ z0, g @ v0
+    h0 = 0.0 if (ip[K.IP_SEP] and p0 < 0) else 1.0
+    n0 = h0 * (k0 * p0 + fp[K.FP_QMB] * pd0)
+    qin, qout = _q_remainders(setup, v0)
+    f = setup.Q0 - setup.C @ v0 - setup.K0 @ z0 - n0 * g
+    f[0] += qin
+    f[5] += qout
+    a0 = np.linalg.solve(setup.M, f)
+    st = np.zeros(K.N_STATE)
+    st[K.S_Z:K.S_Z + 6], st[K.S_V:K.S_V + 6], st[K.S_A:K.S_A + 6] = z0, v0, a0
+    st[K.S_N], st[K.S_K], st[K.S_H], st[K.S_DD] = n0, k0, h0, d - fp[K.FP_D0]
+    st[K.S_IT], st[K.S_RB], st[K.S_RA] = 0.0, np.nan, np.nan
+    st[K.S_QIN], st[K.S_QOUT] = qin, qout
+    return st, np.array([step, 0], dtype=np.int64)
+
+
+def run_steps(setup: KernelSetup, st: np.ndarray, ist: np.ndarray, n_steps: int, *,
+              rec_start: int = 0, decim: int = 1, out: np.ndarray | None = None, j: int = 0,
+              python: bool = False) -> tuple[int, int, np.ndarray]:
+    """Advance ``st`` by ``n_steps`` steps with the compiled kernel (or its Python twin).
+
+    Returns
+    -------
+    (status, j, fail)
+        Status code (0 = success), next free record row, failure information.
+    """
+    if out is None:
+        out = np.empty((0, K.N_REC))
+    fail = np.full(K.N_FAIL, np.nan)
+    fn = K.advance_python if python else K.advance
+    status, j = fn(int(n_steps), int(rec_start), int(decim), out, int(j), st, ist, fail,
+                   *setup.args())
+    return int(status), int(j), fail
+
+
+# --------------------------------------------------------------------------- the case
+def _setup_for_case(case, dyn: DynamicModel, stiffness_map: StiffnessMap, which: str,
+                    static: StaticState) -> KernelSetup:
+    sim = case.simulation
+    Q0, d_in, d_out = dyn.forcing_at_reference()
+    C = dyn.C0.copy()
+    C[0, 0] += d_in
+    C[5, 5] += d_out
+    pair = dyn.pair
+    m_n = pair.module
+    p_lim = max(50.0 * abs(static.mesh_deflection), 0.1 * m_n)
+    y_lim = max(20.0 * max(abs(static.y_p), abs(static.y_g)), m_n)
+    return make_setup(
+        dyn.M, dyn.K0, C, dyn.g, Q0, stiffness_map, dt=sim.dt, model=which,
+        evaluation=sim.stiffness_evaluation, integrator=sim.integrator, hht_alpha=sim.hht_alpha,
+        q_mb=dyn.q_mb, rsum=pair.base_radius_sum, t1t2=pair.design_t1t2,
+        d0=pair.design_centre_distance, tolerance=sim.tolerance, rtol=sim.rtol,
+        max_iterations=sim.max_iterations, speed=dyn.speed, p_lim=p_lim, y_lim=y_lim,
+        separation=True, input_law=dyn.input_law, output_law=dyn.output_law,
+        input_speed=dyn.speed, output_speed=dyn.gear_speed)
+
+
+def simulate(case, stiffness_map: StiffnessMap | None = None, *, model: str | None = None,
+             cracked: bool = True, progress: Callable[[int, int], None] | None = None):
+    r"""Simulate model I or model II of a case and return the record as an xarray Dataset.
+
+    Parameters
+    ----------
+    case : geardyn.config.Case
+        Parameters; ``case.simulation`` gives dt, settle and record time, decimation, tolerances,
+        the stiffness evaluation point and the integrator.
+    stiffness_map : StiffnessMap, optional
+        Any map (PEM, FE, a user table). Default:
+        ``geardyn.stiffness.build_map(case, cracked=cracked)``.
+    model : {"I", "II"}, optional
+        Default ``case.simulation.model``. Model I: ``K(theta)`` at the design centre distance;
+        model II: ``K(theta, d(t))`` iterated each step (the paper's Fig. 7).
+    cracked : bool
+        Passed to ``build_map`` when no map is given.
+    progress : callable, optional
+        ``progress(steps_done, steps_total)`` between kernel chunks.
+
+    Returns
+    -------
+    xarray.Dataset
+        Coordinate ``time`` [s]; the DOFs ``theta_m, y_p, theta_p, y_g, theta_g, theta_out``,
+        velocities ``omega_m, v_yp, omega_p, v_yg, omega_g, omega_out``,
+        ``transmission_error`` (``theta_p - (r_b2/r_b1) theta_g``), ``mesh_force``,
+        ``mesh_deflection``, ``centre_distance_change``, ``pressure_angle``, ``contact_ratio``,
+        ``contact_ratio_eq8``, ``mesh_stiffness``, ``contact``, ``iterations``,
+        ``residual_before``, ``residual_after``; units and provenance in the attributes.
+
+    Raises
+    ------
+    InputError
+        Bad model name, a time step too coarse for the highest natural frequency, a map not
+        covering the operating point, load laws without a steady state.
+    NumericalError
+        Divergence (NaN, runaway deflection), the centre distance leaving the map, or the model II
+        iteration not converging. The record up to the failure is attached as ``exc.partial``
+        (attribute ``complete = 0``).
+    """
+    which = case.simulation.model if model is None else model
+    if which not in ("I", "II"):
+        raise InputError("model", which, "'I' or 'II'")
+    if stiffness_map is None:
+        from ..stiffness import build_map
+
+        stiffness_map = build_map(case, cracked=cracked)
+    sim = case.simulation
+    dyn = DynamicModel.from_case(case, stiffness_map)
+    check_time_step(dyn, stiffness_map, sim.dt)
+    static = static_equilibrium(dyn, stiffness_map, which=which)
+    setup = _setup_for_case(case, dyn, stiffness_map, which, static)
+    dt = sim.dt
+    n_settle = int(round(sim.settle_time / dt))
+    n_record = max(1, int(round(sim.record_time / dt)))
+    decim = sim.decimation
+    count = -(-n_record // decim)
+    n_last = n_settle + (count - 1) * decim
+    out = np.full((count, K.N_REC), np.nan)
+    st, ist = initial_state(setup, static.z)
+    j = 0
+    done = 0
+    if progress is not None:
+        progress(0, n_last)
+    while True:
+        # the first call also records the initial state when nothing is settled
+        n = min(CHUNK_STEPS, n_last - done)
+        status, j, fail = run_steps(setup, st, ist, n, rec_start=n_settle, decim=decim, out=out,
+                                    j=j)
+        done = int(ist[0])
+        if progress is not None:
+            progress(done, n_last)
+        if status != K.OK:
+            ds = _dataset(case, dyn, stiffness_map, which, static, setup, out[:j], n_settle,
+                          decim, complete=False)
+            exc = _numerical_error(status, fail, stiffness_map, which)
+            ds.attrs["failure"] = str(exc)
+            exc.partial = ds
+            raise exc
+        if done >= n_last:
+            break
+    return _dataset(case, dyn, stiffness_map, which, static, setup, out[:j], n_settle, decim,
+                    complete=True)
+
+
+def _numerical_error(status: int, fail: np.ndarray, stiffness_map: StiffnessMap,
+                     which: str) -> NumericalError:
+    msg = f"model {which}: {K.STATUS_TEXT.get(status, f'status {status}')}"
+    if status == K.MAP_RANGE:
+        msg += (f" (centre distance change {fail[5] * 1e3:.6g} mm; the map covers "
+                f"[{stiffness_map.dd[0] * 1e3:.6g}, {stiffness_map.dd[-1] * 1e3:.6g}] mm: widen "
+                "stiffness.centre_distance_min/max or check the loads)")
+    elif status == K.NOT_CONVERGED:
+        msg += " (raise simulation.max_iterations or simulation.tolerance, or reduce dt)"
+    else:
+        msg += " (reduce simulation.dt, check the loads, or use simulation.integrator = 'hht')"
+    state = {name: float(v) for name, v in zip(K.FAIL_NAMES[1:], fail[1:], strict=True)}
+    return NumericalError(msg, time=float(fail[0]), state=state)
+
+
+# --------------------------------------------------------------------------- the record
+_VARS = (
+    # name, units, long name
+    ("theta_m", "rad", "motor rotation angle"),
+    ("y_p", "m", "pinion centre displacement along the line of action"),
+    ("theta_p", "rad", "pinion rotation angle"),
+    ("y_g", "m", "gear centre displacement along the line of action"),
+    ("theta_g", "rad", "gear rotation angle"),
+    ("theta_out", "rad", "load rotation angle"),
+    ("omega_m", "rad/s", "motor angular velocity"),
+    ("v_yp", "m/s", "pinion centre velocity along the line of action"),
+    ("omega_p", "rad/s", "pinion angular velocity"),
+    ("v_yg", "m/s", "gear centre velocity along the line of action"),
+    ("omega_g", "rad/s", "gear angular velocity"),
+    ("omega_out", "rad/s", "load angular velocity"),
+)
+
+
+def _dataset(case, dyn: DynamicModel, stiffness_map: StiffnessMap, which: str,
+             static: StaticState, setup: KernelSetup, rows: np.ndarray, n_settle: int,
+             decim: int, complete: bool):
+    import xarray as xr
+
+    from .. import __version__
+    from ..config import case_to_toml
+    from .model import operating_arrays
+
+    dt = setup.dt
+    n = n_settle + decim * np.arange(rows.shape[0])
+    t = n * dt
+    ref = n * setup.fp[K.FP_HSTEP]  # reference pinion angle, integer step count times w dt
+    e = dyn.reference_direction
+    data: dict[str, tuple] = {}
+    for i, (name, units, long) in enumerate(_VARS[:6]):
+        val = rows[:, K.R_Z + i] + (ref * e[i] if e[i] != 0 else 0.0)
+        data[name] = ("time", val, {"units": units, "long_name": long})
+    for i, (name, units, long) in enumerate(_VARS[6:]):
+        val = rows[:, K.R_V + i] + dyn.speed * e[i]
+        data[name] = ("time", val, {"units": units, "long_name": long})
+    z = rows[:, K.R_Z:K.R_Z + 6]
+    te = z[:, 2] - dyn.r_b2 / dyn.r_b1 * z[:, 4]
+    data["transmission_error"] = ("time", te, {
+        "units": "rad", "long_name": "transmission error theta_p - (r_b2/r_b1) theta_g "
+                                     "(= theta_p - theta_g for equal gears)"})
+    data["mesh_deflection"] = ("time", z @ dyn.g, {
+        "units": "m", "long_name": "mesh deflection along the line of action p (eq. 15)"})
+    data["mesh_force"] = ("time", rows[:, K.R_N], {
+        "units": "N", "long_name": "normal mesh force h N (eq. 14)"})
+    dd = rows[:, K.R_DD]
+    op = operating_arrays(dyn.pair, dd)
+    data["centre_distance_change"] = ("time", dd, {
+        "units": "m", "long_name": "operating minus design centre distance d(t) - d (eq. 4)"})
+    data["pressure_angle"] = ("time", op["pressure_angle"], {
+        "units": "rad", "long_name": "operating pressure angle (eq. 6)"})
+    data["contact_ratio"] = ("time", op["contact_ratio"], {
+        "units": "1", "long_name": "operating contact ratio, physical (s_end - s_start)/p_b"})
+    data["contact_ratio_eq8"] = ("time", op["contact_ratio_eq8"], {
+        "units": "1", "long_name": "operating contact ratio by the paper's eq. 8 "
+                                   "(pi m cos alpha' denominator, erratum 2)"})
+    data["mesh_stiffness"] = ("time", rows[:, K.R_K], {
+        "units": "N/m", "long_name": "mesh stiffness k_mb used in the step"})
+    data["contact"] = ("time", rows[:, K.R_H].astype(np.int8), {
+        "units": "1", "long_name": "tooth contact h (1 in contact, 0 separated; eq. 15)"})
+    data["iterations"] = ("time", rows[:, K.R_IT].astype(np.int32), {
+        "units": "1", "long_name": "re-solves in the step after the first: the model II "
+                                   "centre distance iteration (paper Fig. 9b), and the load "
+                                   "iteration of a nonlinear load law"})
+    data["residual_before"] = ("time", rows[:, K.R_RB], {
+        "units": "m", "long_name": "|b1 - b2| of the first solve of the step (model II; "
+                                   "paper Fig. 9a, red)"})
+    data["residual_after"] = ("time", rows[:, K.R_RA], {
+        "units": "m", "long_name": "|b1 - b2| of the accepted solve (model II; paper Fig. 9a, "
+                                   "black)"})
+    sim = case.simulation
+    dt_max, f_max, f_mesh = max_time_step(dyn, stiffness_map)
+    mattrs = dict(stiffness_map.attrs)
+    attrs = {
+        "title": f"geardyn model {which} simulation of case {case.name!r}",
+        "model": which,
+        "pinion_teeth": int(dyn.pair.pinion.teeth),
+        "gear_teeth": int(dyn.pair.gear.teeth),
+        "dt": float(dt), "dt_units": "s",
+        "settle_time": float(n_settle * dt), "record_time": float(sim.record_time),
+        "decimation": int(decim),
+        "integrator": sim.integrator,
+        "contact_ratio_formula": sim.contact_ratio_formula,
+        "hht_alpha": float(sim.hht_alpha if sim.integrator == "hht" else 0.0),
+        "stiffness_evaluation": sim.stiffness_evaluation,
+        "tolerance": float(sim.tolerance), "tolerance_units": "m",
+        "rtol": float(sim.rtol), "max_iterations": int(sim.max_iterations),
+        "target_speed": float(dyn.speed), "target_speed_units": "rad/s",
+        "input_law": dyn.input_law.describe(),
+        "output_law": dyn.output_law.describe(),
+        "output_law_calibrated": int(dyn.output_calibrated),
+        "mesh_damping": float(dyn.q_mb), "mesh_damping_units": "N s/m",
+        "representative_mesh_stiffness": float(dyn.k_rep),
+        "damping": "; ".join(f"{k} = {v:.6g}" for k, v in dyn.damping.items()),
+        "static_mesh_force": float(static.mesh_force),
+        "static_centre_distance_change": float(static.centre_distance_change),
+        "highest_natural_frequency": float(f_max), "mesh_frequency": float(f_mesh),
+        "max_time_step": float(dt_max),
+        "stiffness_method": str(mattrs.get("method", "")),
+        "stiffness_inputs_hash": str(mattrs.get("inputs_hash", "")),
+        "stiffness_cracked": int(bool(mattrs.get("cracked", 0))),
+        "stiffness_dd_range": f"{stiffness_map.dd[0]:.6g} .. {stiffness_map.dd[-1]:.6g} m",
+        "fixed_point_rule": "model II steps whose handover lies between the iterated centre "
+                            "distances have no fixed point; they are accepted on the first "
+                            "solve's side and keep residual_after >= tolerance",
+        "separation_rule": "h = 1 when the free mesh deflection at t_{n+1} is >= 0 (eq. 15)",
+        "angles": "total angles; theta_p = 0 at t = 0 with pinion tooth 0 at the design pitch "
+                  "point; time counts from the start of the settling phase",
+        "case_toml": case_to_toml(case),
+        "geardyn_version": __version__,
+        "citations": "\n".join(CITATIONS),
+        "steps_without_fixed_point": int(np.sum(rows[:, K.R_RA] >= sim.tolerance)),
+        "complete": int(complete),
+    }
+    return xr.Dataset(data, coords={"time": ("time", t, {"units": "s", "long_name": "time"})},
+                      attrs=attrs)
