@@ -1,0 +1,252 @@
+"""Figures of the paper's case study (analogues of Xue & Howard's Figs. 8-23).
+
+Pure functions: simulation Datasets and diagnosis results in, :class:`matplotlib.figure.Figure`
+out (no pyplot state). Model I is drawn on the left and model II on the right, as in the paper.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from matplotlib.figure import Figure
+
+__all__ = ["SIGNALS", "fig8_design_parameters", "fig9_iteration", "fig10_stiffness",
+           "fig_tsa", "fig_spectra", "fig_residuals", "fig_pwvd_pair", "fig_demodulation_pair",
+           "fig_analytic_pair", "crack_times"]
+
+#: The paper's three signals: name -> (label, unit, symbol)
+SIGNALS = {
+    "v_yg": ("output gear vertical velocity", "m/s", r"$\dot y_g$"),
+    "omega_p": ("input pinion angular velocity", "rad/s", r"$\dot\theta_p$"),
+    "transmission_error": ("transmission error", "rad", r"$\theta_p - \theta_g$"),
+}
+MODELS = ("I", "II")
+COLORS = {"I": "#1f77b4", "II": "#d62728"}
+
+
+def crack_times(ds, crack_angle: float) -> np.ndarray:
+    """Times [s] at which the pinion angle passes ``crack_angle`` [rad] (mod 2 pi)."""
+    th = ds["theta_p"].values
+    t = ds["time"].values
+    k0 = math.ceil((th[0] - crack_angle) / (2 * math.pi))
+    k1 = math.floor((th[-1] - crack_angle) / (2 * math.pi))
+    targets = crack_angle + 2 * math.pi * np.arange(k0, k1 + 1)
+    return np.interp(targets, th, t)
+
+
+def _window(ds, t0: float, t1: float):
+    t = ds["time"].values
+    return (t >= t0) & (t <= t1)
+
+
+def fig8_design_parameters(ds, crack_angle: float | None, window: tuple[float, float]) -> Figure:
+    """Fig. 8 analogue: centre distance change, operating pressure angle and contact ratio of
+    model II against time, with the crack events marked."""
+    fig = Figure(figsize=(8.5, 7.0), layout="constrained")
+    axs = fig.subplots(3, 1, sharex=True)
+    sel = _window(ds, *window)
+    t = ds["time"].values[sel]
+    axs[0].plot(t, ds["centre_distance_change"].values[sel] * 1e3, lw=0.9)
+    axs[0].set_ylabel("centre distance change\n$d(t) - d$ [mm]")
+    axs[1].plot(t, np.degrees(ds["pressure_angle"].values[sel]), lw=0.9)
+    axs[1].set_ylabel("operating pressure\nangle [deg]")
+    axs[2].plot(t, ds["contact_ratio"].values[sel], lw=0.9, label="physical")
+    axs[2].plot(t, ds["contact_ratio_eq8"].values[sel], lw=0.9, label="paper eq. 8")
+    axs[2].set_ylabel("contact ratio [-]")
+    axs[2].legend(loc="best", fontsize=8)
+    axs[2].set_xlabel("time [s]")
+    if crack_angle is not None:
+        for tc in crack_times(ds, crack_angle):
+            if window[0] <= tc <= window[1]:
+                for ax in axs:
+                    ax.axvline(tc, color="0.4", ls="--", lw=0.8)
+        axs[0].set_title("model II (crack events dashed)", fontsize=10)
+    for ax in axs:
+        ax.grid(alpha=0.3)
+    return fig
+
+
+def fig9_iteration(ds_scheme, ds_default, crack_angle: float | None,
+                   window: tuple[float, float], tolerance: float) -> Figure:
+    """Fig. 9 analogue: |b1 - b2| before and after the iteration, iterations per step and the
+    mesh stiffness used, for the paper's start-of-step scheme; the default (predictor) run's
+    first-solve |b1 - b2| is shown for comparison."""
+    fig = Figure(figsize=(8.5, 7.5), layout="constrained")
+    axs = fig.subplots(3, 1, sharex=True)
+    sel = _window(ds_scheme, *window)
+    t = ds_scheme["time"].values[sel]
+    axs[0].plot(t, ds_scheme["residual_before"].values[sel] * 1e6, color="tab:red", lw=0.8,
+                label="before iteration (paper's start-of-step scheme)")
+    axs[0].plot(t, ds_scheme["residual_after"].values[sel] * 1e6, color="k", lw=0.8,
+                label="after iteration")
+    seld = _window(ds_default, *window)
+    axs[0].plot(ds_default["time"].values[seld], ds_default["residual_before"].values[seld] * 1e6,
+                color="tab:green", lw=0.8, label="geardyn default (predictor), first solve")
+    axs[0].axhline(tolerance * 1e6, color="0.5", ls=":", lw=1, label="tolerance")
+    axs[0].set_ylabel(r"$|b_1 - b_2|$ [$\mu$m]")
+    axs[0].legend(fontsize=7, loc="upper right")
+    axs[1].step(t, ds_scheme["iterations"].values[sel], where="mid", lw=0.8)
+    axs[1].set_ylabel("iterations [-]")
+    axs[2].plot(t, ds_scheme["mesh_stiffness"].values[sel], lw=0.8)
+    axs[2].set_ylabel(r"$K_m(\theta, d)$ [N/m]")
+    axs[2].set_xlabel("time [s]")
+    if crack_angle is not None:
+        for tc in crack_times(ds_scheme, crack_angle):
+            if window[0] <= tc <= window[1]:
+                for ax in axs:
+                    ax.axvline(tc, color="0.4", ls="--", lw=0.8)
+    for ax in axs:
+        ax.grid(alpha=0.3)
+    return fig
+
+
+def fig10_stiffness(ds_i, ds_ii, crack_angle: float | None, window: tuple[float, float]) -> Figure:
+    """Fig. 10 analogue: the mesh stiffness the two models used, K_m(theta) and K_m(theta, d)."""
+    fig = Figure(figsize=(8.5, 3.8), layout="constrained")
+    ax = fig.subplots()
+    for ds, lab, m in ((ds_i, r"model I, $K_m(\theta)$", "I"),
+                       (ds_ii, r"model II, $K_m(\theta, d)$", "II")):
+        sel = _window(ds, *window)
+        ax.plot(ds["time"].values[sel], ds["mesh_stiffness"].values[sel], lw=0.9, label=lab,
+                color=COLORS[m])
+    if crack_angle is not None:
+        for tc in crack_times(ds_ii, crack_angle):
+            if window[0] <= tc <= window[1]:
+                ax.axvline(tc, color="0.4", ls="--", lw=0.8)
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("mesh stiffness along the LOA [N/m]")
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3)
+    return fig
+
+
+def _grid(title_fn, plot_fn, diags: dict, signals=SIGNALS, figsize=(11.0, 8.0)) -> Figure:
+    fig = Figure(figsize=figsize, layout="constrained")
+    axs = fig.subplots(len(signals), 2, squeeze=False)
+    for i, sig in enumerate(signals):
+        for j, m in enumerate(MODELS):
+            ax = axs[i, j]
+            plot_fn(ax, diags[m].signals[sig], sig, m)
+            ax.set_title(title_fn(sig, m), fontsize=9)
+            ax.grid(alpha=0.3)
+    return fig
+
+
+def _deg_axis(ax) -> None:
+    ax.set_xlim(0, 360)
+    ax.set_xticks(np.arange(0, 361, 45))
+    ax.set_xlabel("pinion shaft angle [deg]")
+
+
+def fig_tsa(diags: dict) -> Figure:
+    """Fig. 11 analogue: time synchronous averages over one pinion revolution."""
+
+    def plot(ax, sd, sig, m):
+        ang = np.degrees(sd.tsa.angle - sd.tsa.angle[0])
+        ax.plot(ang, sd.tsa.average, lw=0.7, color=COLORS[m])
+        ax.set_ylabel(f"{SIGNALS[sig][2]} [{SIGNALS[sig][1]}]")
+        _deg_axis(ax)
+
+    return _grid(lambda s, m: f"model {m}: TSA of {SIGNALS[s][0]}", plot, diags)
+
+
+def fig_spectra(diags: dict, teeth: int, max_order: int = 160) -> Figure:
+    """Fig. 12 analogue: RMS order spectra (dB re 1 unit) of the TSAs, mesh harmonics marked."""
+    from ..diagnostics import order_spectrum
+
+    def plot(ax, sd, sig, m):
+        sp = order_spectrum(sd.tsa.average - np.mean(sd.tsa.average), scaling="rms", db=True)
+        k = sp.orders <= max_order
+        ax.plot(sp.orders[k], sp.amplitude[k], lw=0.7, color=COLORS[m])
+        for h in range(teeth, max_order + 1, teeth):
+            ax.axvline(h, color="0.6", ls=":", lw=0.7)
+        ax.set_xlabel("shaft order [-]")
+        ax.set_ylabel(f"RMS [dB re 1 {SIGNALS[sig][1]}]")
+
+    return _grid(lambda s, m: f"model {m}: RMS spectrum of {SIGNALS[s][0]}", plot, diags)
+
+
+def fig_residuals(diags: dict) -> Figure:
+    """Fig. 13 analogue: residual signals (mesh harmonics removed)."""
+
+    def plot(ax, sd, sig, m):
+        ang = np.degrees(sd.tsa.angle - sd.tsa.angle[0])
+        ax.plot(ang, sd.residual, lw=0.7, color=COLORS[m])
+        ax.set_ylabel(f"residual [{SIGNALS[sig][1]}]")
+        _deg_axis(ax)
+        ax.text(0.02, 0.92, f"kurtosis {sd.residual_kurtosis:.2f}", transform=ax.transAxes,
+                fontsize=8, va="top")
+
+    return _grid(lambda s, m: f"model {m}: residual of {SIGNALS[s][0]}", plot, diags)
+
+
+def fig_pwvd_pair(diags: dict, sig: str, which: str, teeth: int, max_order: float) -> Figure:
+    """Figs. 14/15/18/21 analogues: PWVD of the TSA (``which="tsa"``) or of the residual."""
+    fig = Figure(figsize=(11.0, 4.3), layout="constrained")
+    axs = fig.subplots(1, 2, sharey=True)
+    for ax, m in zip(axs, MODELS, strict=True):
+        sd = diags[m].signals[sig]
+        pw = sd.pwvd_tsa if which == "tsa" else sd.pwvd_residual
+        k = pw.orders <= max_order
+        ang = np.degrees(pw.angle - pw.angle[0])
+        d = pw.distribution[:, k] if pw.distribution.shape[0] == ang.size else \
+            pw.distribution[k, :].T
+        vmax = np.max(np.abs(d)) or 1.0
+        im = ax.pcolormesh(ang, pw.orders[k], d.T, shading="auto", cmap="viridis",
+                           vmin=0, vmax=vmax, rasterized=True)
+        for h in range(teeth, int(max_order) + 1, teeth):
+            ax.axhline(h, color="w", ls=":", lw=0.5, alpha=0.6)
+        ax.set_title(f"model {m}: PWVD of the {'TSA' if which == 'tsa' else 'residual'} of "
+                     f"{SIGNALS[sig][0]}", fontsize=9)
+        _deg_axis(ax)
+        ax.set_ylabel("shaft order [-]")
+        fig.colorbar(im, ax=ax, label=f"PWVD [({SIGNALS[sig][1]})$^2$]", shrink=0.85)
+    return fig
+
+
+def fig_demodulation_pair(diags: dict, sig: str) -> Figure:
+    """Figs. 16/19/22 analogues: narrowband envelope, amplitude and phase modulation."""
+    fig = Figure(figsize=(11.0, 7.5), layout="constrained")
+    axs = fig.subplots(3, 2, sharex=True)
+    unit = SIGNALS[sig][1]
+    for j, m in enumerate(MODELS):
+        sd = diags[m].signals[sig]
+        dem = sd.demodulation
+        ang = np.degrees(dem.angle - dem.angle[0])
+        axs[0, j].plot(ang, dem.envelope, lw=0.8, color=COLORS[m])
+        axs[0, j].set_ylabel(f"envelope [{unit}]")
+        axs[0, j].set_title(f"model {m}: {SIGNALS[sig][0]}, band {dem.carrier_order} "
+                            f"+/- {dem.bandwidth} orders (kurtosis {sd.envelope_kurtosis:.2f})",
+                            fontsize=9)
+        axs[1, j].plot(ang, dem.am, lw=0.8, color=COLORS[m])
+        axs[1, j].set_ylabel(f"AM [{unit}]")
+        axs[1, j].set_title(f"amplitude modulation (kurtosis {sd.am_kurtosis:.2f})", fontsize=9)
+        axs[2, j].plot(ang, np.degrees(dem.pm), lw=0.8, color=COLORS[m])
+        axs[2, j].set_ylabel("PM [deg]")
+        axs[2, j].set_title(f"phase modulation (kurtosis {sd.pm_kurtosis:.2f})", fontsize=9)
+        _deg_axis(axs[2, j])
+        for i in range(3):
+            axs[i, j].grid(alpha=0.3)
+    return fig
+
+
+def fig_analytic_pair(diags: dict, sig: str) -> Figure:
+    """Figs. 17/20/23 analogues: the baseband analytic signal of the demodulated harmonic in the
+    complex plane (radius = AM, angle = PM), both models."""
+    fig = Figure(figsize=(6.0, 5.6), layout="constrained")
+    ax = fig.subplots()
+    for m in MODELS:
+        z = diags[m].signals[sig].demodulation.baseband
+        ax.plot(z.real, z.imag, lw=0.8, color=COLORS[m], label=f"model {m}")
+        ax.plot(z.real[:1], z.imag[:1], "o", color=COLORS[m], ms=4)
+    ax.axhline(0, color="0.6", lw=0.6)
+    ax.axvline(0, color="0.6", lw=0.6)
+    ax.set_aspect("equal", adjustable="datalim")
+    unit = SIGNALS[sig][1]
+    ax.set_xlabel(f"real part [{unit}]")
+    ax.set_ylabel(f"imaginary part [{unit}]")
+    ax.set_title(f"analytic signal of the demodulated harmonic: {SIGNALS[sig][0]}", fontsize=9)
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3)
+    return fig

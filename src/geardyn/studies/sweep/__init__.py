@@ -1,0 +1,109 @@
+"""Parameter sweeps on Dask into one resumable Zarr store (``geardyn sweep``).
+
+A **sweep file** (TOML, validated like case files: unknown keys are errors, quantities take unit
+strings) names a base case and what changes from run to run::
+
+    name = "crack_torque_bearing"
+    base = "xue_howard"        # a shipped case, or a case file relative to this file
+    seed = 2024                # sampling and per-run seeds
+
+    [set]                      # fixed overrides of the base case (dotted keys)
+    simulation.record_time = "0.5 s"
+
+    [axes]                     # full factorial, first axis slowest
+    crack.depth = ["1 mm", "3 mm", "5 mm"]                             # a list
+    motor.torque = { start = "50 N m", stop = "150 N m", num = 3 }     # a range (num or step)
+    pinion.bearing_stiffness = { start = "5e5 N/m", stop = "2e6 N/m", num = 3, scale = "log" }
+
+    [link]                     # keys that follow a swept key run by run
+    gear.bearing_stiffness = "pinion.bearing_stiffness"
+
+    [sample]                   # quasi-random points, crossed with the grid
+    method = "sobol"           # or "lhs" (scipy.stats.qmc), seeded by `seed`
+    n = 16
+    [sample.dimensions]
+    load.speed = { low = "80 rad/s", high = "150 rad/s" }
+    mesh.damping_ratio = { low = 0.03, high = 0.12, scale = "log" }
+
+    [store]                    # what is kept per run besides the metrics
+    signals = ["v_yg", "omega_p", "transmission_error"]
+    tsa = false                # the synchronous averages
+    raw = false                # the recorded series
+    noise_snr_db = 30          # optional measurement noise, seeded per run
+
+    [execution]
+    batch_size = "auto"        # runs per Dask task; "auto" aims at task_seconds
+    task_seconds = 1.0
+
+Runs are numbered in C order over the grid (first axis slowest) with the sample index
+innermost: ``run = ((i0 * n1 + i1) * n2 + i2) * n_samples + s``.
+
+The **store** (Zarr format 2, consolidated metadata; the format every Zarr reader supports,
+strings as fixed-width ``<U`` which the v2 specification defines) has one dimension ``run``;
+every swept and linked key is a coordinate named by its dotted key (SI values, ``units``
+attribute), with ``seed`` (the run's random seed), and data variables ``status`` (0 pending,
+1 ok, 2 failed), ``error`` (the failure message), ``run_seconds`` and one variable per result,
+e.g. ``v_yg__FM4``, each with ``units`` and ``long_name``. The attributes hold the geardyn
+version, the sweep file, the effective base case and a hash of the sweep definition.
+
+**Execution and safety.** The template (metadata, coordinates, ``status = 0``) is written first,
+into a temporary folder renamed into place. The runs are cut into batches of ``batch_size``
+consecutive runs, the chunk size of every variable along ``run``, so a batch is exactly one chunk
+and no two tasks ever write the same chunk. A worker evaluates its batch (each run in a
+``try``: a run that raises is recorded as failed with its message and the others go on), writes
+the data chunks, then the status chunk. Zarr's local store writes every chunk to a temporary file
+and renames it into place (checked by ``tests/sweep/test_store.py``), so a killed writer leaves
+the old chunk or the new one, never a torn one; a batch killed before its status chunk is written
+still reads as pending and is simply computed again, with the same values (the runs are
+deterministic given their case and seed). Re-running the same command therefore computes only the
+missing runs; a store holding a *different* sweep is refused unless ``force``.
+
+Entry points: :func:`load_sweep`, :meth:`Sweep.plan`, :func:`run_sweep`, :func:`open_sweep`,
+:func:`evaluate_run`.
+"""
+
+from .evaluate import Evaluator, GeardynEvaluator, Output, diagnostic_features, evaluate_run
+from .execute import SweepResult, run_sweep, sweep_digest
+from .spec import (
+    DEFAULT_SIGNALS,
+    Parameter,
+    Sweep,
+    SweepFile,
+    SweepPlan,
+    load_sweep,
+    parse_sweep,
+    run_seeds,
+)
+from .store import (
+    ERROR_CHARS,
+    STATUS_FAILED,
+    STATUS_OK,
+    STATUS_PENDING,
+    open_sweep,
+    store_status,
+)
+
+__all__ = [
+    "STATUS_PENDING",
+    "STATUS_OK",
+    "STATUS_FAILED",
+    "ERROR_CHARS",
+    "DEFAULT_SIGNALS",
+    "SweepFile",
+    "Sweep",
+    "SweepPlan",
+    "Parameter",
+    "Output",
+    "Evaluator",
+    "GeardynEvaluator",
+    "SweepResult",
+    "load_sweep",
+    "parse_sweep",
+    "run_seeds",
+    "evaluate_run",
+    "diagnostic_features",
+    "run_sweep",
+    "sweep_digest",
+    "open_sweep",
+    "store_status",
+]
