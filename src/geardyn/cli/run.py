@@ -46,14 +46,35 @@ def run(
 
         result = run_paper_study(case, out, quick=quick, stiffness=stiffness, progress=progress)
     s = result.summary
-    console.print(f"[green]done[/green]: {', '.join(result.stages)} -> {result.out}/")
-    console.print(f"  centre distance change {s['centre_distance_change_mm']:.4f} mm, "
-                  f"pressure angle {s['operating_pressure_angle_deg']:.4f} deg, contact ratio "
-                  f"{s['contact_ratio']['physical']:.4f} (paper eq. 8: "
-                  f"{s['contact_ratio']['paper_eq8']:.4f})")
-    failed = [v for v in s.get("validation", []) if not v["pass"]]
-    if failed:
-        err_console.print(f"[yellow]{len(failed)} validation row(s) outside tolerance[/yellow] "
-                          "(see summary.json)")
+    from rich.markup import escape
+    from rich.table import Table
 
-
+    t = Table(title=f"geardyn run: {escape(str(result.out))}/", show_lines=False)
+    for col in ("quantity", "geardyn", "paper"):
+        t.add_column(col, justify="left" if col == "quantity" else "right")
+    cr = s.get("contact_ratio", {})
+    rows = [("centre distance change \\[mm]", s.get("centre_distance_change_mm"), "~1.07"),
+            ("operating pressure angle \\[deg]", s.get("operating_pressure_angle_deg"), "21.18"),
+            ("contact ratio, physical / eq. 8",
+             f"{cr.get('physical', float('nan')):.4f} / {cr.get('paper_eq8', float('nan')):.4f}",
+             "- / 1.43"),
+            ("mean pinion speed \\[rad/s]", s.get("mean_pinion_speed_rad_s"), "114.14"),
+            ("mean transmission error \\[rad]", s.get("mean_transmission_error_rad"), "0.05"),
+            ("crack seen at \\[deg]", s.get("crack_angle_deg"), "~170")]
+    for label, ours, paper in rows:
+        if ours is None:
+            continue
+        t.add_row(label, ours if isinstance(ours, str) else f"{ours:.4f}", paper)
+    console.print(t)
+    val = s.get("validation", [])
+    failed = [v for v in val if not v["pass"]]
+    console.print(f"validation against the paper: {len(val) - len(failed)}/{len(val)} within "
+                  f"tolerance; stages: {', '.join(result.stages)} "
+                  f"({sum(result.seconds.values()):.1f} s)")
+    for v in failed:
+        err_console.print(f"[yellow]outside tolerance[/yellow]: {escape(v['quantity'])}: "
+                          f"geardyn {v['geardyn']:.4g}, paper {v['paper']:.4g}")
+    report = result.out / "report.html"
+    if report.exists():
+        console.print(f"report: [bold]{escape(str(report))}[/bold] (self-contained; open it in "
+                      "a browser)")

@@ -108,6 +108,8 @@ def _case_rows(case: Case) -> list[tuple[str, str, str]]:
                 walk(v, key)
             elif isinstance(v, dict):
                 rows.append((key, str(v["value"]), v.get("source", "")))
+            elif key in ("name", "description"):
+                continue
             else:
                 rows.append((key, str(v), case.provenance.get(key, "geardyn default "
                                                                     "(schema default)")))
@@ -264,12 +266,12 @@ def report_stage(case: Case, out: Path, result) -> None:
 
     # ---------------------------------------------------------------- case
     rep.heading("The case and every assumption")
-    rep.paragraph("Every value of the case with its source. Values marked 'geardyn default' are "
-                  "not given by the paper; the source says what geardyn chose and why.")
+    rep.paragraph("Every value of the case with its source. Values marked 'geardyn default' "
+                  "(in amber) are not given by the paper; the source says what geardyn chose "
+                  "and why.")
     rows = _case_rows(case)
     rep.table(["key", "value (SI)", "source"], rows, left_columns=3,
-              classes=[["", "", "fail" if "geardyn" in r[2] and "paper" not in r[2] else ""]
-                       for r in rows])
+              classes=[["", "", "assume" if r[2].startswith("geardyn") else ""] for r in rows])
 
     rep.heading("Errata in the paper that geardyn corrects")
     rep.bullets(ERRATA)
@@ -409,7 +411,7 @@ def report_stage(case: Case, out: Path, result) -> None:
     vrows = [[v["quantity"], v["paper"], v["geardyn"], v["tolerance"],
               "pass" if v["pass"] else "FAIL", v.get("note", "")] for v in val]
     rep.table(["quantity", "paper", "geardyn", "tolerance", "result", "note"], vrows,
-              left_columns=1, classes=[["", "", "", "", "pass" if v["pass"] else "fail", ""]
+              left_columns=1, left=(5,), classes=[["", "", "", "", "pass" if v["pass"] else "fail", ""]
                                        for v in val])
     rep.heading("Where geardyn disagrees with the paper, and why")
     rep.bullets(_disagreements(s))

@@ -39,6 +39,7 @@ td.l, th.l { text-align: left; }
 caption { caption-side: top; text-align: left; font-weight: 600; padding-bottom: .3rem; }
 .pass { color: #16794c; font-weight: 600; }
 .fail { color: #b42318; font-weight: 600; }
+.assume { color: #8a5a00; }
 .note { background: #fff8e6; border-left: 4px solid #f0b429; padding: .5rem .8rem; margin: 1rem 0; }
 code { background: #eef1f7; padding: 0 .25rem; border-radius: 3px; }
 footer { color: #6b7385; font-size: .85rem; margin-top: 3rem; }
@@ -148,21 +149,24 @@ class Report:
         return path
 
     def table(self, header: Sequence[str], rows: Iterable[Sequence[object]], caption: str = "",
-              *, left_columns: int = 1, classes: Sequence[Sequence[str]] | None = None) -> None:
+              *, left_columns: int = 1, classes: Sequence[Sequence[str]] | None = None,
+              left: Sequence[int] = ()) -> None:
         """Add a table; numbers are formatted with :func:`fmt`.
 
+        The first ``left_columns`` columns and those in ``left`` are left-aligned (text);
         ``classes[i][j]`` is an optional CSS class of cell ``(i, j)`` (e.g. ``"pass"``).
         """
+        lefts = set(range(left_columns)) | set(left)
         parts = ["<table>"]
         if caption:
             parts.append(f"<caption>{html.escape(caption)}</caption>")
         parts.append("<tr>" + "".join(
-            f'<th class="{"l" if j < left_columns else ""}">{html.escape(str(h))}</th>'
+            f'<th class="{"l" if j in lefts else ""}">{html.escape(str(h))}</th>'
             for j, h in enumerate(header)) + "</tr>")
         for i, row in enumerate(rows):
             cells = []
             for j, v in enumerate(row):
-                cls = ["l"] if j < left_columns else []
+                cls = ["l"] if j in lefts else []
                 if classes is not None and i < len(classes) and j < len(classes[i]) \
                         and classes[i][j]:
                     cls.append(classes[i][j])

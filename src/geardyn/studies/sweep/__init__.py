@@ -38,25 +38,38 @@ strings) names a base case and what changes from run to run::
 Runs are numbered in C order over the grid (first axis slowest) with the sample index
 innermost: ``run = ((i0 * n1 + i1) * n2 + i2) * n_samples + s``.
 
-The **store** (Zarr format 2, consolidated metadata; the format every Zarr reader supports,
-strings as fixed-width ``<U`` which the v2 specification defines) has one dimension ``run``;
-every swept and linked key is a coordinate named by its dotted key (SI values, ``units``
-attribute), with ``seed`` (the run's random seed), and data variables ``status`` (0 pending,
-1 ok, 2 failed), ``error`` (the failure message), ``run_seconds`` and one variable per result,
-e.g. ``v_yg__FM4``, each with ``units`` and ``long_name``. The attributes hold the geardyn
-version, the sweep file, the effective base case and a hash of the sweep definition.
+The **store** (Zarr format 2 with consolidated metadata: the format every Zarr reader supports,
+strings as fixed-width ``<U``, which the v2 specification defines while Zarr 3 still marks every
+string type unstable) has one dimension ``run``. Coordinates: every swept and linked key, named
+by its dotted key (SI values, ``units``, ``long_name``, ``sweep_role``), and ``seed`` (the run's
+seed). Data variables: ``status`` (0 pending, 1 ok, 2 failed; CF ``flag_values`` /
+``flag_meanings``), ``error`` (a failed run's message), ``warning`` (warnings the run raised),
+``worker`` (``host:pid`` that computed it), ``run_seconds`` (its wall time) and one variable per
+result, e.g. ``v_yg__FM4``, each with ``units`` and ``long_name`` (see
+:class:`GeardynEvaluator`). The attributes hold the geardyn and library versions, the sweep file
+text, the effective base case (TOML), the sweep hash, the batch size and the grid shape. Open it
+with ``xarray.open_zarr`` or :func:`open_sweep` (``unstack=True`` gives one dimension per axis).
 
-**Execution and safety.** The template (metadata, coordinates, ``status = 0``) is written first,
-into a temporary folder renamed into place. The runs are cut into batches of ``batch_size``
-consecutive runs, the chunk size of every variable along ``run``, so a batch is exactly one chunk
-and no two tasks ever write the same chunk. A worker evaluates its batch (each run in a
-``try``: a run that raises is recorded as failed with its message and the others go on), writes
-the data chunks, then the status chunk. Zarr's local store writes every chunk to a temporary file
-and renames it into place (checked by ``tests/sweep/test_store.py``), so a killed writer leaves
-the old chunk or the new one, never a torn one; a batch killed before its status chunk is written
-still reads as pending and is simply computed again, with the same values (the runs are
-deterministic given their case and seed). Re-running the same command therefore computes only the
-missing runs; a store holding a *different* sweep is refused unless ``force``.
+**Execution and safety.** The store must be on a filesystem every worker sees (checked before
+any task runs). The template (metadata, coordinates, ``status = 0``) is written first, into a
+temporary folder renamed into place. The runs are cut into batches of ``batch_size`` consecutive
+runs, the chunk length of every variable along ``run``, so a batch is exactly one chunk and no
+two tasks ever write the same chunk. A worker evaluates its batch (each run in a ``try``: a run
+that raises is recorded as failed with its message and the others go on), writes the data
+chunks, then the status chunk. Zarr's local store writes every chunk to a temporary file and
+renames it into place (checked by ``tests/sweep/test_store.py``), so a killed writer leaves the
+old chunk or the new one, never a torn one; a batch killed before its status chunk is written
+still reads as pending and is computed again, with the same values (a run is deterministic given
+its case and seed). Re-running the same command therefore computes only the missing runs
+(failed runs stay recorded unless ``retry_failed``); a store holding a *different* sweep (another
+definition, base case, store options or geardyn version) is refused unless ``force``. The
+``[execution]`` section is not part of the sweep's identity: a resumed store keeps its batches.
+
+**Batching.** With ``batch_size = "auto"`` one run is timed on a worker (after a warm-up run
+that loads the compiled kernels and the stiffness map) and a task gets
+``ceil(task_seconds / t_run)`` runs, with the number of tasks rounded up to whole rounds of the
+workers. Before the runs, each distinct stiffness map of the sweep is built once, in parallel
+(:meth:`Evaluator.prepare`), so workers never build the same map twice at once.
 
 Entry points: :func:`load_sweep`, :meth:`Sweep.plan`, :func:`run_sweep`, :func:`open_sweep`,
 :func:`evaluate_run`.

@@ -9,7 +9,9 @@ from __future__ import annotations
 import contextlib
 import math
 import os
+import signal
 import socket
+import threading
 import time
 import uuid
 import warnings
@@ -207,8 +209,16 @@ def _dask_client(scheduler: str | None, workers: int | None, client) -> Iterator
             cl.close()
         return
     n = workers or os.cpu_count() or 1
-    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                           dashboard_address=None, silence_logs=logging.ERROR)
+    # the worker processes ignore Ctrl-C (SIGINT reaches the whole terminal process group):
+    # this process cancels the tasks and closes the cluster, with no traceback from each worker
+    main = threading.current_thread() is threading.main_thread()
+    old = signal.signal(signal.SIGINT, signal.SIG_IGN) if main else None
+    try:
+        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                               dashboard_address=None, silence_logs=logging.ERROR)
+    finally:
+        if main:
+            signal.signal(signal.SIGINT, old)
     cl = Client(cluster)
     try:
         yield cl

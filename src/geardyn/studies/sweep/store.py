@@ -158,7 +158,13 @@ def _create_store(out: Path, ds, batch: int) -> None:
             warnings.simplefilter("ignore", category=UserWarning)
             ds.to_zarr(str(tmp), mode="w-", compute=False, zarr_format=ZARR_FORMAT,
                        consolidated=True, encoding=encoding)
-        os.rename(tmp, out)
+        try:
+            os.rename(tmp, out)
+        except OSError:
+            if out.exists():
+                raise DataFileError(out, "was created by another process at the same time; "
+                                         "re-run the command to resume it") from None
+            raise
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
         raise
@@ -250,7 +256,13 @@ def _write_batch(out: str, start: int, stop: int, results: Mapping[int, RunRecor
     written concurrently (zarr's asynchronous API, about twice as fast as one by one); the
     status chunk is written only after all of them are in place.
     """
-    from zarr.core.sync import sync
+    try:
+        from zarr.core.sync import sync  # zarr's own bridge to its event loop (zarr >= 3)
+    except ImportError:  # pragma: no cover - a zarr without it: plain asyncio
+        import asyncio
+
+        def sync(coro):
+            return asyncio.run(coro)
 
     sync(_write_batch_async(out, start, stop, results, outputs))
 
@@ -316,8 +328,8 @@ def _check_values_shapes(values: Mapping[str, Any], outputs: Sequence[Output]) -
 
 def _check_out(out: Path, digest: str, force: bool) -> bool:
     """True if ``out`` holds this sweep (resume); False if it must be created."""
-    if not out.exists():
-        return False
+    if not out.exists() or (out.is_dir() and not any(out.iterdir())):
+        return False  # new (an empty folder is replaced by the store)
     if not out.is_dir() or not _is_store(out):
         raise DataFileError(out, "exists and is not a Zarr store; choose another --out")
     attrs = _read_attrs(out)
