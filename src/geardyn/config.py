@@ -14,6 +14,7 @@ value is read as a TOML value when it parses as one, otherwise as a string.
 from __future__ import annotations
 
 import copy
+import functools
 import json
 import math
 import tomllib
@@ -519,6 +520,7 @@ def paper_case(overrides: Iterable[str] | Mapping[str, Any] = ()) -> Case:
 
 
 # --------------------------------------------------------------------------- writing
+@functools.cache  # builds a JSON schema: slow, and the answer never changes
 def _dimension_of(model: type[BaseModel], name: str) -> str | None:
     """The physical dimension of a quantity field (from its JSON-schema unit), else None."""
     schema = model.model_json_schema()["properties"].get(name, {})

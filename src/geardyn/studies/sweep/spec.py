@@ -43,8 +43,6 @@ class _SweepModel(BaseModel):
 
 Scalar = bool | int | float | str
 
-_RANGE_KEYS = {"start", "stop", "num", "step", "scale"}
-_DIM_KEYS = {"low", "high", "scale"}
 
 
 class RangeSpec(_SweepModel):
@@ -176,13 +174,13 @@ class SweepFile(_SweepModel):
             if isinstance(data.get(name), dict):
                 data[name] = _flatten(data[name], lambda v: not isinstance(v, dict))
         if isinstance(data.get("axes"), dict):
-            data["axes"] = _flatten(data["axes"], lambda v: not isinstance(v, dict) or (
-                "start" in v and set(v) <= _RANGE_KEYS))
+            data["axes"] = _flatten(data["axes"], lambda v: not isinstance(v, dict) or bool(
+                set(v) & {"start", "stop", "num", "step"}))
         sample = data.get("sample")
         if isinstance(sample, dict) and isinstance(sample.get("dimensions"), dict):
             data["sample"] = {**sample, "dimensions": _flatten(
-                sample["dimensions"], lambda v: not isinstance(v, dict) or (
-                    ("low" in v or "high" in v) and set(v) <= _DIM_KEYS))}
+                sample["dimensions"], lambda v: not isinstance(v, dict) or bool(
+                    set(v) & {"low", "high"}))}
         return data
 
 
@@ -199,55 +197,71 @@ def _flatten(tree: dict, is_leaf: Callable[[Any], bool], prefix: str = "") -> di
     return out
 
 
-def _format_sweep_error(exc: ValidationError, data: Any) -> InputError:
+_TYPE_LOCS = ("function-", "list[", "literal[", "RangeSpec", "DimensionSpec", "int", "str",
+              "bool", "float")
+
+
+def _field_path(loc: Sequence) -> str:
+    """A pydantic error location as a sweep-file field: ``axes.crack.depth[1]`` (the union
+    branch names pydantic inserts are dropped)."""
+    out = ""
+    for p in loc:
+        if isinstance(p, int):
+            out += f"[{p}]"
+        elif not str(p).startswith(_TYPE_LOCS) or str(p) in SweepFile.model_fields:
+            out += f".{p}" if out else str(p)
+    return out or "sweep"
+
+
+def _format_sweep_error(exc: ValidationError) -> InputError:
     """The first pydantic error as an :class:`InputError` naming the sweep-file field."""
     errs = exc.errors(include_url=False)
     # in a union (a list or a range), report the branch matching what was written
     wrong_branch = {"list_type", "model_type", "dict_type", "model_attributes_type"}
     errs = sorted(errs, key=lambda e: e["type"] in wrong_branch)
     first = errs[0]
-    type_names = {"list[union[bool,int,float,str]]", "RangeSpec", "list", "int", "str",
-                  "literal['auto']", "function-after", "bool", "float"}
-    loc = [p for p in first["loc"] if str(p) not in type_names
-           and not str(p).startswith(("function-", "list[", "literal["))]
-    field_name = ""
-    for p in loc:
-        field_name += f"[{p}]" if isinstance(p, int) else (f".{p}" if field_name else str(p))
-    field_name = field_name or "sweep"
+    field_name = _field_path(first["loc"])
     msg = first["msg"]
-    scalar_union = {"bool_type", "int_type", "float_type", "string_type", "bool_parsing",
-                    "int_parsing", "float_parsing"}
-    if len({e["type"] for e in errs if tuple(e["loc"][:2]) == tuple(first["loc"][:2])}
-           & scalar_union) > 1:
-        msg = "a number, a string with a unit, true/false or a string (one value)"
     for prefix in ("Value error, ", "Assertion failed, "):
         if msg.startswith(prefix):
             msg = msg[len(prefix):]
+    same = [e for e in errs if _field_path(e["loc"]) == field_name]
+    scalar_union = {"bool_type", "int_type", "float_type", "string_type", "bool_parsing",
+                    "int_parsing", "float_parsing"}
+    if len({e["type"] for e in same} & scalar_union) > 1:
+        msg = "a number, a string with a unit, true/false or a string (one value)"
     if first["type"] == "extra_forbidden":
-        parent = _model_at(loc[:-1])
+        parent = _model_at(first["loc"][:-1])
         allowed = sorted(parent.model_fields) if parent is not None else []
         msg = "a known key; allowed keys here: " + ", ".join(allowed)
     elif first["type"] == "missing":
         msg = "a value (this required field is missing)"
-    more = f" (and {len(errs) - 1} more problem{'s' if len(errs) > 2 else ''})" \
-        if len(errs) > 1 else ""
-    value = first.get("input")
-    if first["type"] == "missing":
-        value = None
+    others = len({_field_path(e["loc"]) for e in errs} - {field_name})
+    more = f" (and {others} more problem{'s' if others > 1 else ''})" if others else ""
+    value = None if first["type"] == "missing" else first.get("input")
     return InputError(field_name, value, msg + more)
 
 
 def _model_at(loc: Sequence) -> type[BaseModel] | None:
+    """The sweep-file model at an error location (for the list of allowed keys), if any."""
+    parts = [str(p) for p in loc if not isinstance(p, int)
+             and (not str(p).startswith(_TYPE_LOCS) or str(p) in SweepFile.model_fields)]
     model: type[BaseModel] = SweepFile
-    for p in loc:
-        f = model.model_fields.get(str(p))
+    i = 0
+    while i < len(parts):
+        f = model.model_fields.get(parts[i])
         if f is None:
-            return None if model is not SweepFile or p else model
-        subs = [a for a in typing.get_args(f.annotation) or (f.annotation,)
+            return None
+        ann = _strip_optional(f.annotation)
+        if typing.get_origin(ann) is dict:  # axes, dimensions: the next part is a dotted key
+            ann = typing.get_args(ann)[1]
+            i += 1
+        subs = [a for a in typing.get_args(ann) or (ann,)
                 if isinstance(a, type) and issubclass(a, BaseModel)]
         if not subs:
             return None
         model = subs[0]
+        i += 1
     return model
 
 
@@ -641,7 +655,7 @@ def parse_sweep(text: str, *, base_dir: str | os.PathLike | None = None,
     try:
         spec = SweepFile.model_validate(raw)
     except ValidationError as exc:
-        raise _format_sweep_error(exc, raw) from None
+        raise _format_sweep_error(exc) from None
     return _resolve(spec, text, origin, Path(base_dir) if base_dir is not None else Path.cwd())
 
 

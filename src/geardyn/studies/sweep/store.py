@@ -5,12 +5,15 @@ as fixed-width ``<U``, which the v2 specification defines, where Zarr 3 still ma
 type unstable). One dimension ``run``; every variable is chunked along it in batches of
 ``batch_size`` runs, so one Dask task writes exactly one chunk of each variable.
 
-Crash safety: zarr-python's ``LocalStore`` writes each chunk to ``<key>.<uuid>.partial`` and
-renames it over the key (``tests/sweep/test_store.py`` checks this on the installed version), so
-a chunk is either the old one or the new one. A task writes its data chunks first and the status
-chunk last: a batch killed in between is still pending and is redone with the same values.
-Stale ``*.partial`` files are removed when a sweep resumes; a status chunk that cannot be read
-counts as pending.
+Crash safety: zarr-python's ``LocalStore`` (since 3.1.3, zarr-python PR #3412; zarr 2's
+``DirectoryStore`` did the same) writes each chunk to ``<key>.<uuid>.partial`` and renames it
+over the key (``tests/sweep/test_store.py`` checks this on the installed version), so a chunk is
+either the old one or the new one. A task writes its data chunks first and the status chunk
+last: a batch killed in between is still pending and is redone with the same values. Stale
+``*.partial`` files are removed when a sweep resumes. With a store that does not write
+atomically the design degrades gracefully: a torn data chunk belongs to a batch whose status was
+never written (so it is redone), and a torn (undecodable) status chunk counts as pending. Writes
+are not fsynced: a power cut (not a killed process) may lose recent chunks of the page cache.
 """
 
 from __future__ import annotations
