@@ -48,6 +48,23 @@ def _sha256_file(path: Path) -> str:
     return h.hexdigest()
 
 
+@contextlib.contextmanager
+def _entry_lock(path: Path):
+    """Exclusive advisory lock on ``<entry>.lock`` (POSIX ``flock``; no-op elsewhere)."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    try:
+        import fcntl
+    except ImportError:  # pragma: no cover - not POSIX
+        yield
+        return
+    with open(path.with_name(path.name + ".lock"), "a+") as fh:
+        fcntl.flock(fh.fileno(), fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(fh.fileno(), fcntl.LOCK_UN)
+
+
 class Cache:
     """A folder of checksummed entries.
 
@@ -111,16 +128,21 @@ class Cache:
             The object, and whether it came from the cache.
         """
         path = self.path(kind, key, suffix)
-        if self.enabled and path.exists():
-            if self.valid(path, key):
-                try:
-                    return load(path), True
-                except Exception:  # unreadable despite checksum (format change): rebuild
+        if not self.enabled:
+            return build(), False
+        # One builder per entry: a second process wanting the same entry waits for the first
+        # and then loads its result, so concurrent runs do the work once and leave one valid
+        # entry.
+        with _entry_lock(path):
+            if path.exists():
+                if self.valid(path, key):
+                    try:
+                        return load(path), True
+                    except Exception:  # unreadable despite checksum (format change): rebuild
+                        self.discard(path)
+                else:
                     self.discard(path)
-            else:
-                self.discard(path)
-        obj = build()
-        if self.enabled:
+            obj = build()
             self.store(obj, path, key, save)
         return obj, False
 

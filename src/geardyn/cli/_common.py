@@ -21,7 +21,8 @@ from rich.markup import escape
 
 from ..errors import GeardynError
 
-__all__ = ["ConfigOption", "SetOption", "OutOption", "load_case_from_cli", "handle_errors",
+__all__ = ["ConfigOption", "SetOption", "OutOption", "ForceOption", "refuse_overwrite",
+           "load_case_from_cli", "handle_errors",
            "console", "err_console", "progress_bar"]
 
 F = TypeVar("F", bound=Callable[..., Any])
@@ -44,6 +45,21 @@ OutOption = Annotated[
     Path,
     typer.Option("--out", "-o", help="Output folder."),
 ]
+ForceOption = Annotated[
+    bool,
+    typer.Option("--force", "-f", help="Overwrite existing outputs."),
+]
+
+
+def refuse_overwrite(paths, force: bool, option: str = "--out") -> None:
+    """Raise an InputError naming ``option`` if any of ``paths`` exists and not ``force``."""
+    from ..errors import InputError
+
+    existing = [str(p) for p in paths if Path(p).exists()]
+    if existing and not force:
+        raise InputError(option, existing[0], "a path with no earlier result in it (it exists; "
+                                              "pass --force to overwrite, or choose another "
+                                              f"{option})")
 
 
 def load_case_from_cli(config: Path | None, overrides: list[str] | None):

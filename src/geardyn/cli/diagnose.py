@@ -8,7 +8,15 @@ from typing import Annotated
 import typer
 
 from . import app
-from ._common import ConfigOption, SetOption, console, handle_errors, load_case_from_cli
+from ._common import (
+    ConfigOption,
+    ForceOption,
+    SetOption,
+    console,
+    handle_errors,
+    load_case_from_cli,
+    refuse_overwrite,
+)
 
 
 @app.command("diagnose")
@@ -41,12 +49,17 @@ def diagnose(
                                                                   "times [s].")] = False,
     pulses_per_rev: Annotated[int, typer.Option("--pulses-per-rev", min=1,
                                                 help="Tachometer pulses per revolution.")] = 1,
+    figures: Annotated[bool, typer.Option("--figures/--no-figures",
+                                          help="Write the figures (PNG) as well as metrics.json."
+                                          )] = True,
+    force: ForceOption = False,
 ) -> None:
     """Run TSA, spectra, residual, demodulation, PWVD and condition metrics; write figures and
     metrics.json into OUT."""
     from ..diagnostics import diagnose_file
 
     case = load_case_from_cli(config, set_)
+    refuse_overwrite([out / "metrics.json"], force)
     d = case.diagnostics
     is_sim = file.suffix.lower() in (".nc", ".nc4", ".netcdf")
     if teeth is None and not is_sim:
@@ -56,7 +69,7 @@ def diagnose(
         tach_column_is_pulse_times=tach_times, pulses_per_rev=pulses_per_rev,
         angle_unit=angle_unit, samples_per_rev=d.samples_per_rev, harmonic=d.harmonic,
         bandwidth=d.bandwidth, residual_preset=d.residual_preset)
-    result.write(out)
+    result.write(out, figures=figures)
     summary = result.to_dict()
     console.print(f"[green]done[/green]: metrics and figures in {out}/")
     for name, sig in summary.get("signals", {}).items():

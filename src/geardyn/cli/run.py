@@ -10,12 +10,14 @@ import typer
 from . import app
 from ._common import (
     ConfigOption,
+    ForceOption,
     SetOption,
     console,
     err_console,
     handle_errors,
     load_case_from_cli,
     progress_bar,
+    refuse_overwrite,
 )
 
 
@@ -30,6 +32,7 @@ def run(
     stiffness: Annotated[str | None, typer.Option(
         "--stiffness", help="Mesh stiffness method: fe or pem (default: the case's).",
         show_default=False)] = None,
+    force: ForceOption = False,
 ) -> None:
     """Reproduce the paper's case study (model I vs II, healthy and cracked) into OUT."""
     from ..errors import InputError
@@ -38,6 +41,7 @@ def run(
     if stiffness is not None and stiffness not in ("fe", "pem"):
         raise InputError("--stiffness", stiffness, "'fe' or 'pem'")
     case = load_case_from_cli(config, set_)
+    refuse_overwrite([out / "summary.json", out / "report.html"], force)
     with progress_bar() as bar:
         task = bar.add_task("geardyn run", total=None)
 

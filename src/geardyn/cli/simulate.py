@@ -11,12 +11,14 @@ import typer
 from . import app
 from ._common import (
     ConfigOption,
+    ForceOption,
     SetOption,
     console,
     err_console,
     handle_errors,
     load_case_from_cli,
     progress_bar,
+    refuse_overwrite,
 )
 
 
@@ -39,6 +41,7 @@ def simulate(
     stiffness: Annotated[str | None, typer.Option(
         "--stiffness", help="Mesh stiffness method: pem or fe (default: the case's).",
         show_default=False)] = None,
+    force: ForceOption = False,
 ) -> None:
     """Simulate the gear pair (Newmark, paper section 4) and write the record to OUT."""
     from ..dynamics import save_mat, save_netcdf, summary
@@ -54,6 +57,7 @@ def simulate(
         raise InputError("--stiffness", stiffness, "'pem' or 'fe'")
     if out.exists() and out.is_dir():
         raise InputError("--out", str(out), "a file path (it is a folder)")
+    refuse_overwrite([out] + ([out.with_suffix(".mat")] if mat else []), force)
     with progress_bar() as bar:
         task = bar.add_task("stiffness map", total=None)
 

@@ -13,12 +13,14 @@ import typer
 from . import app
 from ._common import (
     ConfigOption,
+    ForceOption,
     SetOption,
     console,
     err_console,
     handle_errors,
     load_case_from_cli,
     progress_bar,
+    refuse_overwrite,
 )
 
 
@@ -41,6 +43,7 @@ def stiffness(
         "--method", "-m", help="Mesh stiffness method: pem (potential energy) or fe.")] = "pem",
     out: Annotated[Path, typer.Option("--out", "-o", help="Output folder.")
                    ] = Path("geardyn-out/stiffness"),
+    force: ForceOption = False,
 ) -> None:
     """Compute (or load from the cache) the stiffness maps and plot Figs. 5 and 6 into OUT."""
     import numpy as np
@@ -60,6 +63,7 @@ def stiffness(
                              "'pem' (the finite-element route is not available in this "
                              "installation)") from None
     case = load_case_from_cli(config, set_)
+    refuse_overwrite([out / "stiffness_healthy.nc", out / "stiffness_cracked.nc"], force)
     has_crack = case.crack is not None and case.crack.enabled
     maps = {}
     with progress_bar() as bar, warnings.catch_warnings():

@@ -529,7 +529,7 @@ def static_equilibrium(model: DynamicModel, stiffness_map, *, which: str = "II",
                          f"map range [{stiffness_map.dd[0] * 1e3:.4g}, "
                          f"{stiffness_map.dd[-1] * 1e3:.4g}] mm",
                          f"a stiffness map covering the static centre distance change "
-                         f"{dd_eval * 1e3:.4f} mm of model {which}")
+                         f"{dd_eval * 1e3:.6g} mm of model {which}")
     k0 = float(stiffness_map(theta0, dd_eval))
     if not k0 > 0:
         raise InputError("stiffness_map", k0, "a positive mesh stiffness at the start")

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import InputError, NumericalError
+from ..errors import GeardynError, InputError, NumericalError
 from ..stiffness.map import MapArrays, StiffnessMap
 from . import _kernel as K
 from .model import (
@@ -322,16 +322,27 @@ def simulate(case, stiffness_map: StiffnessMap | None = None, *, model: str | No
 
         stiffness_map = build_map(case, cracked=cracked)
     sim = case.simulation
-    dyn = DynamicModel.from_case(case, stiffness_map)
-    check_time_step(dyn, stiffness_map, sim.dt)
-    static = static_equilibrium(dyn, stiffness_map, which=which)
-    setup = _setup_for_case(case, dyn, stiffness_map, which, static)
+    try:
+        with np.errstate(over="raise", invalid="raise", divide="raise"):
+            dyn = DynamicModel.from_case(case, stiffness_map)
+            check_time_step(dyn, stiffness_map, sim.dt)
+            static = static_equilibrium(dyn, stiffness_map, which=which)
+            setup = _setup_for_case(case, dyn, stiffness_map, which, static)
+    except GeardynError:
+        raise
+    except (FloatingPointError, OverflowError, ZeroDivisionError, ValueError,
+            np.linalg.LinAlgError) as exc:
+        fields = _extreme_fields(case)
+        raise InputError(", ".join(fields) or "case", "values whose products overflow or are "
+                         f"singular ({exc})", "physical magnitudes: the model's matrices and "
+                         "static equilibrium must stay finite") from None
     dt = sim.dt
     n_settle = int(round(sim.settle_time / dt))
     n_record = max(1, int(round(sim.record_time / dt)))
     decim = sim.decimation
     count = -(-n_record // decim)
     n_last = n_settle + (count - 1) * decim
+    _check_record_size(count, sim)
     out = np.full((count, K.N_REC), np.nan)
     st, ist = initial_state(setup, static.z)
     j = 0
@@ -357,6 +368,38 @@ def simulate(case, stiffness_map: StiffnessMap | None = None, *, model: str | No
             break
     return _dataset(case, dyn, stiffness_map, which, static, setup, out[:j], n_settle, decim,
                     complete=True)
+
+
+def _extreme_fields(case) -> list[str]:
+    """Dotted keys of the case's numbers that are far outside any physical range."""
+    out = []
+    data = case.model_dump(mode="python", exclude={"provenance"})
+
+    def walk(node, prefix):
+        for k, v in node.items():
+            key = f"{prefix}.{k}" if prefix else k
+            if isinstance(v, dict):
+                walk(v, key)
+            elif isinstance(v, float) and v != 0 and not (1e-30 < abs(v) < 1e30):
+                out.append(f"{key} = {v:g}")
+
+    walk(data, "")
+    return out
+
+
+def _check_record_size(count: int, sim) -> None:
+    """Refuse a record that would not fit in memory (limit ``$GEARDYN_MAX_RECORD_GB``, default
+    8 GB, about 4 times the record itself once it becomes a Dataset)."""
+    import os
+
+    limit_gb = float(os.environ.get("GEARDYN_MAX_RECORD_GB", "8"))
+    need_gb = 4 * count * K.N_REC * 8 / 1e9
+    if need_gb > limit_gb:
+        raise InputError(
+            "simulation.record_time", sim.record_time,
+            f"a record that fits in memory: {count} samples x {K.N_REC} variables needs about "
+            f"{need_gb:.3g} GB (limit {limit_gb:g} GB, set by GEARDYN_MAX_RECORD_GB); raise "
+            "simulation.decimation, lengthen simulation.dt or shorten simulation.record_time")
 
 
 def _numerical_error(status: int, fail: np.ndarray, stiffness_map: StiffnessMap,

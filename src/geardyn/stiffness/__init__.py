@@ -23,7 +23,7 @@ def centre_distance_grid(case) -> np.ndarray:
 
 
 #: Bump when a method's physics or numerics change, so cached maps are rebuilt.
-MODEL_VERSIONS = {"pem": "1", "fe": "1"}
+MODEL_VERSIONS = {"pem": "1", "fe": "2"}
 
 
 def map_inputs(case, method: str, cracked: bool) -> dict:

@@ -451,7 +451,9 @@ class StiffnessMap:
         )
         units = {"load_share": ("1", "load sharing ratio of the slot's tooth pair"),
                  "pairs_in_contact": ("1", "number of tooth pairs in contact"),
-                 "transmission_error": ("rad", "static transmission error (pinion angle)")}
+                 "transmission_error": ("rad", "static transmission error (pinion angle)"),
+                 "load_share_exiting": ("1", "load sharing ratio of the pair past the end of "
+                                             "the theoretical path (extended contact, FE)")}
         for name, v in self.extra.items():
             dims = ("centre_distance_change", "node") + tuple(f"{name}_dim{k}"
                                                               for k in range(2, v.ndim))

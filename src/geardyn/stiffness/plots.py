@@ -66,6 +66,10 @@ def pair_load_share(m: StiffnessMap, theta, dd: float, pinion_tooth: int) -> np.
         sel = m.slot_tooth[c, k] == pinion_tooth
         if np.any(sel):
             out[sel] = m(theta[sel], dd, variable="load_share", slot=k)
+    if "load_share_exiting" in m.extra:  # FE: extended contact of the previous cycle's slot 0
+        sel = m.slot_tooth[(c - 1) % m.n_cycles, 0] == pinion_tooth
+        if np.any(sel):
+            out[sel] += m(theta[sel], dd, variable="load_share_exiting")
     return out
 
 

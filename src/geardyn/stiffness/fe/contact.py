@@ -311,7 +311,8 @@ def solve_compatibility(c0: np.ndarray, gap: np.ndarray, arm: np.ndarray, torque
     f, dth, w = _qp(c0, gap, arm, torque, first)
     it = 0
     if local is not None:
-        for it in range(1, max_iter + 1):
+        for k in range(1, max_iter + 1):
+            it = k
             c = c0 + np.diag(local(f))
             f_new, dth_new, w = _qp(c, gap, arm, torque, f > 0)
             done = abs(dth_new - dth) <= tol * abs(dth_new) and \
@@ -409,12 +410,15 @@ class PairContactModel:
         b = np.sqrt(4 * f * cand.radius / (math.pi * self.estar))
         return -(2 / math.pi) * (1 / self.e1 + 1 / self.e2) * np.log(b / self.half_width)
 
+    def solve_candidates(self, cand: Candidates, torque_per_width: float) -> ContactResult:
+        """Loaded contact of given candidates for the pinion torque per unit width [N m/m]."""
+        c0 = self.compliance(cand)
+        local = (lambda f: self.local_term(cand, f)) if self.local_enabled else None
+        return solve_compatibility(c0, cand.gap, cand.arm, torque_per_width, local)
+
     def solve(self, theta: float, dd: float, torque_per_width: float,
               margin: float = 0.35) -> tuple[Candidates, ContactResult]:
         """Candidates and loaded contact at ``(theta, dd)`` for the pinion torque per unit width
         [N m/m]."""
         cand = candidates(self.pair, theta, dd, margin=margin)
-        c0 = self.compliance(cand)
-        local = (lambda f: self.local_term(cand, f)) if self.local_enabled else None
-        res = solve_compatibility(c0, cand.gap, cand.arm, torque_per_width, local)
-        return cand, res
+        return cand, self.solve_candidates(cand, torque_per_width)

@@ -41,7 +41,7 @@ from ...errors import InputError, NumericalError
 from ...geometry import Gear
 
 __all__ = ["MeshSettings", "CrackGeometry", "BodyMesh", "build_body_mesh", "loaded_flank",
-           "critical_fillet_point", "tooth_offsets"]
+           "critical_fillet_point", "crack_segment", "tooth_offsets"]
 
 
 @dataclass(frozen=True)
@@ -222,6 +222,13 @@ def crack_segment(gear: Gear, crack: CrackGeometry) -> tuple[np.ndarray, np.ndar
     mouth = critical_fillet_point(gear)
     direction = np.array([math.sin(crack.angle), -math.cos(crack.angle)])  # to +x: centreline
     tip = mouth + crack.depth * direction
+    if abs(tip[0]) >= abs(mouth[0]):
+        # the same domain as the PEM's crack model: the tip stays within the tooth's root
+        # section (it must not reach past the opposite fillet's abscissa)
+        raise InputError("crack.depth", crack.depth,
+                         f"a root crack whose tip stays inside the tooth section (tip at "
+                         f"{abs(tip[0]):.4g} m from the centreline, mouth at "
+                         f"{abs(mouth[0]):.4g} m)")
     poly = _closed_polygon(gear)
     s = np.linspace(0.02, 1.0, 60)[:, None]
     inside = _inside(poly, mouth + s * crack.depth * direction)
@@ -236,7 +243,7 @@ def crack_segment(gear: Gear, crack: CrackGeometry) -> tuple[np.ndarray, np.ndar
 
 
 def build_body_mesh(gear: Gear, settings: MeshSettings, crack: CrackGeometry | None = None,
-                    *, n_points: int = 60) -> BodyMesh:
+                    *, n_points: int = 150) -> BodyMesh:
     """Mesh a whole gear body with gmsh (run in-process, single thread, no GUI).
 
     Parameters

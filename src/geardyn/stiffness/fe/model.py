@@ -28,15 +28,20 @@ import numpy as np
 
 from ...errors import InputError
 from ...geometry import Gear
-from .contact import BodyCompliance, PairContactModel
+from .contact import BodyCompliance, PairContactModel, candidates
 from .mesh import CrackGeometry, MeshSettings, build_body_mesh
-from .solve import BodyInfluence, ElasticBody, ElasticMaterial, influence_matrices, \
-    load_roll_lengths
+from .solve import (
+    BodyInfluence,
+    ElasticBody,
+    ElasticMaterial,
+    influence_matrices,
+    load_roll_lengths,
+)
 
 __all__ = ["FESettings", "body_influence", "FEStiffness", "FORMAT_VERSION"]
 
 #: bump when the stored influence data change meaning
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2
 
 PATCH_FACTOR = 0.04  # b_ref / m
 MESH_FACTOR = 0.08  # default tooth-zone element size / m
@@ -192,11 +197,10 @@ class FEStiffness:
             self.from_cache[name] = hit
             if progress is not None:
                 progress(k + 1, len(jobs))
-        comp = {k: BodyCompliance(v, self.pair.pinion.teeth if k == "pinion" else
-                                  (self.pair.gear.teeth if k == "gear" else
-                                   (self.pair.pinion.teeth if case.crack.gear == "pinion"
-                                    else self.pair.gear.teeth)))
-                for k, v in self.influence.items()}
+        teeth = {"pinion": self.pair.pinion.teeth, "gear": self.pair.gear.teeth}
+        if crack is not None:
+            teeth["cracked"] = teeth[case.crack.gear]
+        comp = {k: BodyCompliance(v, teeth[k]) for k, v in self.influence.items()}
         self.model = PairContactModel(
             self.pair, comp["pinion"], comp["gear"], cracked=comp.get("cracked"),
             crack_gear=case.crack.gear if crack is not None else "pinion",
@@ -220,8 +224,12 @@ class FEStiffness:
         Returns
         -------
         dict
-            ``k_mb`` [N/m], ``load_share`` (n, 3) by load-share slot, ``pairs_in_contact``,
-            ``transmission_error`` [rad], ``torsional_stiffness`` [N m/rad].
+            ``k_mb`` [N/m]; ``load_share`` (n, 3) [-], slot ``k`` holding pair ``n_exit + 1 + k``
+            with ``n_exit = floor((s(theta) - s_end) / p_b)`` the last pair to have passed the
+            end of the theoretical path (:attr:`StiffnessMap.slot_tooth`);
+            ``load_share_exiting`` [-], the share still carried by pair ``n_exit`` in extended
+            contact beyond the theoretical end; ``pairs_in_contact`` [-] (loaded pairs);
+            ``transmission_error`` [rad] (pinion hub rotation under the torque).
         """
         theta = np.atleast_1d(np.asarray(theta, float))
         pair = self.pair
@@ -232,25 +240,23 @@ class FEStiffness:
         k_mb = np.empty(n)
         te = np.empty(n)
         share = np.zeros((n, 3))
+        exiting = np.zeros(n)
         npair = np.zeros(n)
-        memo: dict[int, tuple] = {}
+        memo: dict[int, tuple] = {}  # healthy teeth: the same result in every mesh cycle
         for i, th in enumerate(theta):
-            s_theta = pair.pitch_point_s + rb1 * th
-            n_exit = math.floor((s_theta - s_end) / pb)
-            cycle = math.floor((s_theta - s_end) / pb)
-            key = round(((th - cycle * tm) % tm) / tm * 1e9)
-            hit = None
-            if self.model.cracked is None or not self._near_crack(th, dd):
-                hit = memo.get(key)
+            n_exit = math.floor((pair.pitch_point_s + rb1 * th - s_end) / pb)
+            key = round(((th - n_exit * tm) % tm) / tm * 1e9)
+            cand = candidates(pair, th, dd)
+            cyclic = not self.model.involves_crack(cand)
+            hit = memo.get(key) if cyclic else None
             if hit is None:
-                cand, res = self.solve(th, dd)
+                res = self.model.solve_candidates(cand, self.torque_per_width)
                 f = res.force
                 tot = f.sum()
-                rel = cand.pair - n_exit
-                hit = (res.rotation, tuple((int(r), float(x / tot)) for r, x in zip(rel, f,
-                                                                                     strict=True)),
-                       int(np.sum(f > 1e-9 * tot)))
-                if self.model.cracked is None or not self._near_crack(th, dd):
+                shares = tuple((int(p - n_exit), float(x / tot))
+                               for p, x in zip(cand.pair, f, strict=True))
+                hit = (res.rotation, shares, int(np.sum(f > 1e-9 * tot)))
+                if cyclic:
                     memo[key] = hit
             rot, shares, npc = hit
             te[i] = rot
@@ -258,14 +264,11 @@ class FEStiffness:
             for r, x in shares:
                 if 1 <= r <= 3:
                     share[i, r - 1] = x
+                elif r == 0:
+                    exiting[i] = x
             npair[i] = npc
-        return {"k_mb": k_mb, "load_share": share, "pairs_in_contact": npair,
-                "transmission_error": te}
-
-    def _near_crack(self, theta: float, dd: float) -> bool:
-        from .contact import candidates
-
-        return self.model.involves_crack(candidates(self.pair, theta, dd))
+        return {"k_mb": k_mb, "load_share": share, "load_share_exiting": exiting,
+                "pairs_in_contact": npair, "transmission_error": te}
 
     def attrs(self) -> dict:
         """Provenance of maps made by this model."""
@@ -286,6 +289,12 @@ class FEStiffness:
             "elements": "P2 triangles (scikit-fem), whole gear bodies fixed at the bore",
             "dofs": {k: int(v.get("dofs", 0)) for k, v in st.items()},
             "crack": None if self.crack is None else asdict(self.crack),
+            "parameters": {"crack": None if self.crack is None else {
+                "gear": self.case.crack.gear, "tooth": int(self.case.crack.tooth),
+                "depth_m": self.crack.depth, "angle_rad": self.crack.angle,
+                "mouth": "loaded fillet, 30 deg tangent point (ISO 6336-3)"}},
+            "cracked": int(self.crack is not None),
+            "case": self.case.name,
             "citations": [
                 "Xue & Howard (2018) Mech. Syst. Signal Process., section 3",
                 "Johnson (1985) Contact Mechanics, eq. 5.36",
