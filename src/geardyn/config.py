@@ -247,6 +247,10 @@ class StiffnessConfig(_Model):
                                   description="Number of centre distances in the map.")
     nodes_per_segment: int = Field(24, ge=2, le=4096, strict=True,
                                    description="Map nodes in each single/double contact zone.")
+    body_torsion: bool = Field(False, description="PEM: add each gear body's elastic torsion "
+                                                  "between bore and root circle in series with "
+                                                  "the mesh (hub-to-hub stiffness, as FE and the "
+                                                  "paper's FEA report it).")
     fe: FEConfig = Field(default_factory=FEConfig)
 
     @model_validator(mode="after")

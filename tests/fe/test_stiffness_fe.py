@@ -18,7 +18,7 @@ from geardyn.errors import InputError
 from geardyn.stiffness.fe import fe_map
 from geardyn.stiffness.fe.contact import PATH, candidates
 from geardyn.stiffness.iso import iso_stiffness
-from geardyn.stiffness.map import StiffnessMap
+from geardyn.stiffness.map import StiffnessMap, zone_boundaries
 from geardyn.stiffness.pem import PEMModel
 
 from .conftest import coarse_settings
@@ -85,16 +85,30 @@ def test_fe_and_pem_in_single_contact(steel_model, steel_case):
     assert np.all(np.abs(kf[sel] / kp[sel] - 1) < 0.20)
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "Known gap: with the paper's boundary conditions (hub fixed, whole body to the 20 mm bore) "
-    "the FE couples adjacent loaded teeth through the gear body (shared rim deformation and "
-    "torsion), which the PEM's K = sum k_pair ignores (trap T13): double-contact FE is ~31 % "
-    "below the PEM and the cycle mean ~26 % below (steel, plane strain). See "
-    "test_fe_and_pem_single_tooth_compliance for the like-for-like comparison."))
-def test_fe_and_pem_mean_within_10_percent(steel_model, steel_case):
-    _, kf, kp = _pem_and_fe(steel_model, steel_case, 0.0)
-    assert kf.mean() == pytest.approx(kp.mean(), rel=0.10)
-    assert np.all(np.abs(kf / kp - 1) < 0.20)
+def test_fe_and_pem_with_body_torsion_like_for_like(steel_model, steel_case):
+    """FE against the PEM measured the same way (hub to hub). The FE's torsional stiffness
+    includes the bodies' torsion down to the bore, as the paper's FEA K_t does (trap T5); the
+    classic PEM's pairs in parallel do not, and come out ~25 % stiffer on the mean. With the
+    exact annulus torsion in series (``stiffness.body_torsion``) the means agree within 10 % and
+    every position agrees within 20 % except within 5 % of a mesh cycle of a handover, where the
+    FE's extended contact under load rounds the PEM's steps (a physical difference by design)."""
+    pair = steel_model.pair
+    tm = pair.mesh_angle
+    th = np.linspace(0, tm, 240, endpoint=False)
+    plain = PEMModel.from_case(steel_case, cracked=False)
+    torsion = PEMModel.from_case(steel_case.with_overrides({"stiffness.body_torsion": True}),
+                                 cracked=False)
+    for dd in (0.0, 1.0e-3):
+        kf = steel_model.evaluate(th, dd)["k_mb"]
+        kp, kt = plain.evaluate(th, dd)["k_mb"], torsion.evaluate(th, dd)["k_mb"]
+        assert kf.mean() < 0.85 * kp.mean()  # the classic PEM misses the body torsion
+        assert kf.mean() == pytest.approx(kt.mean(), rel=0.10)
+        pa, la = zone_boundaries(pair, [dd])
+        handovers = np.array([pa[0], pa[0] + la[0]])
+        dist = np.min(np.abs(((th[:, None] - handovers + tm / 2) % tm) - tm / 2), axis=1) / tm
+        away = dist > 0.05
+        assert away.mean() > 0.75
+        assert np.all(np.abs(kf[away] / kt[away] - 1) < 0.20)
 
 
 def test_inter_tooth_coupling_is_physical(steel_model):

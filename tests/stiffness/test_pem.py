@@ -423,3 +423,27 @@ def test_pem_map_outputs(case):
         warnings.simplefilter("ignore", SainsotRangeWarning)
         mg = pem_map(other, dd[:2], cracked=True)
     assert mg.n_cycles == 48
+
+
+def test_body_torsion_compliance_is_the_annulus_integral():
+    """phi/T = int_{r_int}^{r_f} dr / (2 pi G b r^3), integrated numerically, against the closed
+    form; the map's series combination 1/(1/k + r_b1^2 c1 + r_b2^2 c2)."""
+    from scipy.integrate import quad
+
+    from geardyn.stiffness.pem import PEMModel, body_torsion_compliance
+
+    case = geardyn.paper_case()
+    g = case.gear_pair().pinion
+    E, nu = 69e9, 0.33
+    G = E / (2 * (1 + nu))
+    num, _ = quad(lambda r: 1 / (2 * np.pi * G * g.face_width * r ** 3), g.bore_radius,
+                  g.root_radius, epsabs=0, epsrel=1e-13)
+    assert body_torsion_compliance(g, E, nu) == pytest.approx(num, rel=1e-11)
+    plain = PEMModel.from_case(case, cracked=False)
+    tors = PEMModel.from_case(case.with_overrides({"stiffness.body_torsion": True}),
+                              cracked=False)
+    th = np.linspace(0, 2 * np.pi / 23, 50)
+    k, kt = plain.mesh_stiffness(th), tors.mesh_stiffness(th)
+    c = 2 * g.base_radius ** 2 * num
+    np.testing.assert_allclose(kt, 1 / (1 / k + c), rtol=1e-10)
+    np.testing.assert_array_equal(plain.evaluate(th)["load_share"], tors.evaluate(th)["load_share"])

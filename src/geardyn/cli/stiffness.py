@@ -55,13 +55,6 @@ def stiffness(
 
     if method not in ("pem", "fe"):
         raise InputError("--method", method, "'pem' or 'fe'")
-    if method == "fe":
-        try:
-            from ..stiffness.fe import fe_map  # noqa: F401
-        except ImportError:
-            raise InputError("--method", method,
-                             "'pem' (the finite-element route is not available in this "
-                             "installation)") from None
     case = load_case_from_cli(config, set_)
     refuse_overwrite([out / "stiffness_healthy.nc", out / "stiffness_cracked.nc"], force)
     has_crack = case.crack is not None and case.crack.enabled
@@ -90,6 +83,10 @@ def stiffness(
             "fig5_load_sharing.png": fig_load_sharing(maps["healthy"])}
     if "cracked" in maps:
         figs["fig6_crack.png"] = fig_crack(maps["healthy"], maps["cracked"])
+    if method == "fe":
+        from ..stiffness.fe import plot_mesh
+
+        figs["fe_mesh.png"] = plot_mesh(case, cracked=has_crack)
     for fname, fig in figs.items():
         with atomic_path(out / fname, suffix=".png") as tmp:
             fig.savefig(tmp, dpi=150, format="png")

@@ -46,6 +46,8 @@ def map_inputs(case, method: str, cracked: bool) -> dict:
     }
     if method == "fe":
         data["fe"] = case.stiffness.fe.model_dump(mode="json")
+    else:
+        data["body_torsion"] = case.stiffness.body_torsion
     return data
 
 

@@ -195,6 +195,11 @@ def stiffness_stage(case: Case, out: Path, result: StudyResult) -> None:
     cracked.to_netcdf(out / "stiffness_cracked.nc")
     result.figures["fig5_stiffness"] = fig_stiffness(healthy)
     result.figures["fig5_load_sharing"] = fig_load_sharing(healthy)
+    if case.stiffness.method == "fe":
+        from ..stiffness.fe import plot_mesh
+
+        result.figures["fig_fe_mesh"] = plot_mesh(case, cracked=case.crack is not None
+                                                  and case.crack.enabled)
     if case.crack is not None and case.crack.enabled:
         result.figures["fig6_crack"] = fig_crack(healthy, cracked)
         result.summary["crack_angle_in_stiffness_deg"] = math.degrees(
