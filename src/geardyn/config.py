@@ -492,16 +492,10 @@ def load_case(path: str | Path | None = None, overrides: Iterable[str] | Mapping
         text = resources.files("geardyn.cases").joinpath(f"{PAPER_CASE}.toml").read_text("utf-8")
         origin = f"geardyn/cases/{PAPER_CASE}.toml"
     else:
-        p = Path(path)
-        try:
-            text = p.read_text(encoding="utf-8")
-        except FileNotFoundError:
-            raise DataFileError(p, "no such file") from None
-        except IsADirectoryError:
-            raise DataFileError(p, "is a directory, not a case file") from None
-        except (OSError, UnicodeDecodeError) as exc:
-            raise DataFileError(p, f"cannot be read ({exc})") from None
-        origin = str(p)
+        from .io import read_text
+
+        text = read_text(path, "case file")
+        origin = str(path)
     try:
         raw = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:

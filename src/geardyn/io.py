@@ -17,7 +17,7 @@ from pathlib import Path
 from .errors import DataFileError
 
 __all__ = ["atomic_path", "write_bytes_atomic", "write_text_atomic", "write_json_atomic", "json_safe",
-           "write_netcdf_atomic", "read_netcdf"]
+           "write_netcdf_atomic", "read_text", "read_netcdf"]
 
 
 @contextlib.contextmanager
@@ -94,6 +94,26 @@ def write_netcdf_atomic(ds, path: str | os.PathLike) -> None:
     """Write an xarray Dataset to NetCDF-4 (h5netcdf engine) atomically."""
     with atomic_path(path, suffix=".nc") as tmp:
         ds.to_netcdf(tmp, engine="h5netcdf")
+
+
+def read_text(path: str | os.PathLike, kind: str = "text file") -> str:
+    """Read a UTF-8 text file, turning every failure into a :class:`DataFileError`.
+
+    Parameters
+    ----------
+    path : path-like
+    kind : str
+        What the file should be, for the message (``"case file"``, ``"sweep file"``).
+    """
+    p = Path(path)
+    try:
+        return p.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise DataFileError(p, "no such file") from None
+    except IsADirectoryError:
+        raise DataFileError(p, f"is a directory, not a {kind}") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise DataFileError(p, f"cannot be read ({exc})") from None
 
 
 def read_netcdf(path: str | os.PathLike, required: Iterable[str] = ()):

@@ -72,7 +72,8 @@ def test_config_schema():
 
 def test_run_writes_the_geometry_stage(tmp_path):
     out = tmp_path / "out"
-    r = run("run", "--out", str(out))
+    r = run("run", "--out", str(out), "--quick", "--stiffness", "pem", "--set",
+            "simulation.record_time=0.1 s", "--set", "diagnostics.samples_per_rev=512")
     assert r.returncode == 0, r.stderr
     s = json.loads((out / "summary.json").read_text())
     assert s["centre_distance_change_mm"] == pytest.approx(1.0852, abs=1e-4)

@@ -10,7 +10,8 @@ import xarray as xr
 
 GEARDYN = [sys.executable, "-m", "geardyn"]
 SHORT = ["--set", "simulation.settle_time=0.002", "--set", "simulation.record_time=0.004",
-         "--set", "stiffness.centre_distances=6", "--set", "stiffness.nodes_per_segment=8"]
+         "--set", "stiffness.centre_distances=6", "--set", "stiffness.nodes_per_segment=8",
+         "--set", "stiffness.method=pem"]
 
 
 def run(*args, cache):

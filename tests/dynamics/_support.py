@@ -18,7 +18,8 @@ K_PAIR = 8e7  # N/m, one tooth pair of the paper's aluminium gears (design/dynam
 
 def short_case(**over):
     """The paper's case with short times (tens of ms) and any dotted overrides."""
-    base = {"simulation.settle_time": 0.0, "simulation.record_time": 0.02}
+    base = {"simulation.settle_time": 0.0, "simulation.record_time": 0.02,
+            "stiffness.method": "pem"}
     base.update({k.replace("__", "."): v for k, v in over.items()})
     return geardyn.paper_case(base)
 

@@ -27,3 +27,22 @@ def test_errors_are_one_line_with_status_2(tmp_path, args, words):
     assert r.returncode == 2, r.stdout + r.stderr
     assert words in r.stderr and "Traceback" not in r.stderr
     assert not (tmp_path / "o.zarr").exists()
+
+
+def test_config_and_set_change_the_base_case_and_the_identity(tmp_path):
+    """--set overrides reach every run's case, are recorded in the store, and a store made with
+    other overrides is not resumed by mistake."""
+    import xarray as xr
+
+    (tmp_path / "s.toml").write_text('[axes]\n"motor.torque" = ["80 N m", "120 N m"]\n')
+    ev = "tests.sweep._evaluators:OscillatorEvaluator"
+    base = [*GEARDYN, "sweep", str(tmp_path / "s.toml"), "--out", str(tmp_path / "o.zarr"),
+            "--workers", "1", "--evaluator", ev]
+    r = subprocess.run([*base, "--set", "pinion.mass=0.9 kg"], capture_output=True, text=True,
+                       env=env(), timeout=300, cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    ds = xr.open_zarr(tmp_path / "o.zarr")
+    assert "--set 'pinion.mass=0.9 kg'" in ds.attrs["sweep_file"]
+    r2 = subprocess.run([*base, "--set", "pinion.mass=1.1 kg"], capture_output=True, text=True,
+                        env=env(), timeout=300, cwd=tmp_path)
+    assert r2.returncode == 2 and "--force" in r2.stderr

@@ -72,9 +72,11 @@ def diagnose(
     result.write(out, figures=figures)
     summary = result.to_dict()
     console.print(f"[green]done[/green]: metrics and figures in {out}/")
+    def num(v) -> str:
+        return f"{v:.4g}" if isinstance(v, int | float) else "n/a"
+
     for name, sig in summary.get("signals", {}).items():
         k = sig.get("kurtosis", {})
         console.print(f"  {name}: {sig.get('n_averages')} revolutions averaged; kurtosis of TSA "
-                      f"{k.get('tsa', float('nan')):.4g}, residual {k.get('residual', float('nan')):.4g}"
-                      f", envelope {k.get('envelope', float('nan')):.4g}, PM "
-                      f"{k.get('phase_modulation', float('nan')):.4g}")
+                      f"{num(k.get('tsa'))}, residual {num(k.get('residual'))}, envelope "
+                      f"{num(k.get('envelope'))}, PM {num(k.get('phase_modulation'))}")

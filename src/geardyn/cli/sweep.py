@@ -1,9 +1,10 @@
 """``geardyn sweep``: a parameter sweep on Dask into one resumable Zarr store.
 
-The sweep file is the single source of truth (its base case and overrides are inside it and it is
-stored in the Zarr attributes), so this command takes no ``--config``/``--set``: a store can
-always be traced back to exactly the file that made it. Re-running the same command after an
-interruption computes only the missing runs.
+The sweep file holds the base case, its overrides and the swept values; ``--config`` replaces its
+base case and ``--set`` adds overrides to it. Both become part of the sweep's identity (a store
+made with other values is not resumed by mistake) and are recorded with the sweep file's text in
+the Zarr attributes. Re-running the same command after an interruption computes only the missing
+runs.
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ from typing import Annotated
 import typer
 
 from . import app
-from ._common import console, err_console, handle_errors, progress_bar
+from ._common import ConfigOption, SetOption, console, err_console, handle_errors, progress_bar
 
 
 def _load_evaluator(spec: str):
@@ -41,6 +42,27 @@ def _load_evaluator(spec: str):
     return obj
 
 
+def with_base_case(sw, config: Path | None, overrides: list[str]):
+    """The sweep with ``--config`` as its base case (plus the sweep's own ``[set]``) and the
+    ``--set`` overrides applied; the command line is appended to the stored sweep text."""
+    import dataclasses
+    import shlex
+
+    from ..config import load_case
+
+    if config is None and not overrides:
+        return sw
+    base = sw.base_case
+    if config is not None:
+        base = load_case(config, {k: v for k, v in (sw.spec.set or {}).items()})
+    if overrides:
+        base = base.with_overrides(overrides)
+    cli = " ".join(([f"--config {shlex.quote(str(config))}"] if config else [])
+                   + [f"--set {shlex.quote(o)}" for o in overrides])
+    return dataclasses.replace(sw, base_case=base,
+                               text=sw.text.rstrip("\n") + f"\n# geardyn sweep {cli}\n")
+
+
 @app.command("sweep")
 @handle_errors
 def sweep(
@@ -61,12 +83,14 @@ def sweep(
         "--evaluator", help="Advanced: module:attribute of a custom Evaluator computing each run "
                             "instead of geardyn's simulation + diagnostics.",
         show_default=False)] = None,
+    config: ConfigOption = None,
+    set_: SetOption = None,
 ) -> None:
     """Run the sweep in SWEEP_FILE on Dask into the Zarr store OUT (resumable: re-run the same
     command after an interruption to compute only the missing runs)."""
     from ..studies.sweep import load_sweep, open_sweep, run_sweep
 
-    sw = load_sweep(sweep_file)
+    sw = with_base_case(load_sweep(sweep_file), config, set_ or [])
     ev = _load_evaluator(evaluator) if evaluator else None
     with progress_bar() as bar:
         task = bar.add_task(f"sweep {sw.spec.name}", total=sw.n_runs)

@@ -375,6 +375,12 @@ def map_mean(stiffness_map, dd: float, n: int = 4096) -> float:
     return float(np.mean(stiffness_map(th, np.full(n, d))))
 
 
+def _mm(v: float) -> str:
+    """A length in mm for messages: four decimals, or 4 significant digits when absurd."""
+    x = v * 1e3
+    return f"{x:.4f}" if abs(x) < 1e9 else f"{x:.4g}"
+
+
 def _static_dd(pair: GearPair, mesh_force: float, kyp: float, kyg: float) -> float:
     """Centre distance change [m] with the bearings deflected by the mesh force (eq. 4)."""
     yp, yg = -mesh_force / kyp, mesh_force / kyg
@@ -529,7 +535,7 @@ def static_equilibrium(model: DynamicModel, stiffness_map, *, which: str = "II",
                          f"map range [{stiffness_map.dd[0] * 1e3:.4g}, "
                          f"{stiffness_map.dd[-1] * 1e3:.4g}] mm",
                          f"a stiffness map covering the static centre distance change "
-                         f"{dd_eval * 1e3:.6g} mm of model {which}")
+                         f"{_mm(dd_eval)} mm of model {which}")
     k0 = float(stiffness_map(theta0, dd_eval))
     if not k0 > 0:
         raise InputError("stiffness_map", k0, "a positive mesh stiffness at the start")

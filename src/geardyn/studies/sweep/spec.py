@@ -620,14 +620,9 @@ def load_sweep(path: str | os.PathLike) -> Sweep:
         shipped = resources.files("geardyn.cases").joinpath(f"{stem}.toml")
         if shipped.is_file():
             p = Path(str(shipped))
-    try:
-        text = p.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise DataFileError(p, "no such file") from None
-    except IsADirectoryError:
-        raise DataFileError(p, "is a directory, not a sweep file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise DataFileError(p, f"cannot be read ({exc})") from None
+    from ...io import read_text
+
+    text = read_text(p, "sweep file")
     return parse_sweep(text, base_dir=p.parent, origin=str(p))
 
 
