@@ -200,3 +200,30 @@ def test_metric_input_errors():
         fm0(np.cos(TH[:32]), teeth=23)
     with pytest.raises(InputError, match="d: .*index 1"):
         fm4([1.0, np.nan, 2.0])
+
+
+@pytest.mark.parametrize("scale", [1e-200, 1e-9, 4.8e92, 1e300])
+def test_moment_ratios_are_scale_invariant_without_overflow(scale):
+    """Kurtosis, skewness, crest factor, FM4/M6A/M8A, NA4 and NA4* do not depend on the unit of
+    the signal, and huge or tiny signals neither overflow nor underflow."""
+    import warnings
+
+    from geardyn.diagnostics import fm4, m6a, m8a, na4, na4_star, signal_statistics
+
+    rng = np.random.default_rng(3)
+    x = np.sin(np.linspace(0, 40, 2048)) + 0.3 * rng.standard_normal(2048)
+    h = np.sin(np.linspace(0, 40, 2048))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no RuntimeWarning (overflow) allowed
+        a, b = signal_statistics(x), signal_statistics(scale * x)
+        for f in (fm4, m6a, m8a):
+            assert f(scale * x) == pytest.approx(f(x), rel=1e-12)
+        assert na4(scale * x, [scale * h]) == pytest.approx(na4(x, [h]), rel=1e-12)
+        v0 = float(np.var(h))
+        if 1e-300 < scale * scale < 1e300:  # the baseline variance itself is representable
+            assert na4_star(scale * x, v0 * scale * scale) == pytest.approx(na4_star(x, v0),
+                                                                           rel=1e-12)
+    for k in ("skewness", "kurtosis", "crest_factor", "crest_factor_rms"):
+        assert getattr(b, k) == pytest.approx(getattr(a, k), rel=1e-12)
+    assert b.std == pytest.approx(scale * a.std, rel=1e-12)
+    assert b.mean == pytest.approx(scale * a.mean, rel=1e-12)

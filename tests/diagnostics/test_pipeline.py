@@ -286,3 +286,16 @@ def test_diagnose_input_checks(measured):
         diagnose({"a": v, "b": v[:-1]}, teeth=Z, angle=theta)
     with pytest.raises(InputError, match="residual_preset"):
         diagnose({"a": v}, teeth=Z, angle=theta, samples_per_rev=512, residual_preset="x")
+
+
+def test_signals_too_large_for_their_squares_are_refused():
+    """The PWVD and energies are in unit^2: a signal beyond 1e150 cannot be represented."""
+    import numpy as np
+    import pytest
+
+    from geardyn.diagnostics import diagnose
+    from geardyn.errors import InputError
+
+    th = np.linspace(0, 8 * np.pi, 4000)
+    with pytest.raises(InputError, match="1e\\+?150"):
+        diagnose({"x": 1e200 * np.cos(23 * th)}, teeth=23, angle=th, fs=1000.0)

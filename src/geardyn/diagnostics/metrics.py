@@ -88,14 +88,24 @@ def central_moment(x, order: int) -> float:
     return float(np.mean((xa - xa.mean()) ** order))
 
 
+def _deviation_scaled(x: np.ndarray) -> tuple[np.ndarray, float]:
+    """``((x - mean) / s, s)`` with ``s = max|x - mean|``: moment ratios computed on the scaled
+    deviation are exact and cannot overflow (|x| ~ 1e80 would overflow ``x**4``)."""
+    big = float(np.max(np.abs(x))) if x.size else 0.0
+    xs = x / big if big > 0 else x
+    d = xs - xs.mean()
+    s = float(np.max(np.abs(d)))
+    return (d / s if s > 0 else d), s * big if big > 0 else s
+
+
 def _normalised_moment(x: np.ndarray, order: int, name: str) -> float:
-    d = x - x.mean()
-    m2 = float(np.mean(d * d))
+    z, _ = _deviation_scaled(x)
+    m2 = float(np.mean(z * z))
     if not m2 > 0:
         warnings.warn(f"{name}: constant signal (zero variance); returning NaN",
                       DiagnosticsWarning, stacklevel=3)
         return math.nan
-    return float(np.mean(d**order)) / m2 ** (order / 2)
+    return float(np.mean(z**order)) / m2 ** (order / 2)
 
 
 def kurtosis(x) -> float:
@@ -165,20 +175,26 @@ def signal_statistics(x) -> SignalStatistics:
         and a :class:`DiagnosticsWarning`.
     """
     xa = _as_float_array(x, "x", min_size=2)
-    mu = float(xa.mean())
-    d = xa - mu
-    m2 = float(np.mean(d * d))
-    rms = float(np.sqrt(np.mean(xa * xa)))
-    if m2 > 0:
-        std = math.sqrt(m2)
-        skew = float(np.mean(d**3)) / m2**1.5
-        kurt = float(np.mean(d**4)) / m2**2
-        cf = float(np.max(np.abs(d))) / std
+    # everything on x / max|x| (then scaled back), so no power overflows for huge signals
+    big = float(np.max(np.abs(xa)))
+    xs = xa / big if big > 0 else xa
+    scale = big if big > 0 else 1.0
+    mu = float(xs.mean()) * scale
+    z, _ = _deviation_scaled(xs)
+    dmax = float(np.max(np.abs(xs - xs.mean())))
+    m2z = float(np.mean(z * z))
+    rms_s = float(np.sqrt(np.mean(xs * xs)))
+    rms = rms_s * scale
+    if m2z > 0:
+        std = math.sqrt(m2z) * dmax * scale
+        skew = float(np.mean(z**3)) / m2z**1.5
+        kurt = float(np.mean(z**4)) / m2z**2
+        cf = 1.0 / math.sqrt(m2z)
     else:
         warnings.warn("signal_statistics: constant signal (zero variance); normalised "
                       "statistics are NaN", DiagnosticsWarning, stacklevel=2)
         std, skew, kurt, cf = 0.0, math.nan, math.nan, math.nan
-    cf_rms = float(np.max(np.abs(xa))) / rms if rms > 0 else math.nan
+    cf_rms = float(np.max(np.abs(xs))) / rms_s if rms_s > 0 else math.nan
     return SignalStatistics(mean=mu, std=std, skewness=skew, kurtosis=kurt, crest_factor=cf,
                             crest_factor_rms=cf_rms, rms=rms,
                             peak_to_peak=float(xa.max() - xa.min()), n=int(xa.size))
@@ -259,14 +275,15 @@ def na4(r, history: Iterable = ()) -> float:
         NA4 [-].
     """
     ra = _as_float_array(r, "r", min_size=2)
-    m2s = [central_moment(h, 2) for h in history]
-    m2s.append(central_moment(ra, 2))
-    den = float(np.mean(m2s)) ** 2
-    if not den > 0:
+    records = [_as_float_array(h, "history", min_size=2) for h in history] + [ra]
+    # one common scale for every record: the ratio is unchanged and no power overflows
+    s = max(float(np.max(np.abs(h - h.mean()))) for h in records)
+    if not s > 0:
         warnings.warn("na4: zero residual variance; returning NaN", DiagnosticsWarning,
                       stacklevel=2)
         return math.nan
-    return central_moment(ra, 4) / den
+    m2s = [float(np.mean(((h - h.mean()) / s) ** 2)) for h in records]
+    return float(np.mean(((ra - ra.mean()) / s) ** 4)) / float(np.mean(m2s)) ** 2
 
 
 def na4_star(r, baseline_variance: float) -> float:
@@ -286,7 +303,11 @@ def na4_star(r, baseline_variance: float) -> float:
     """
     if not (np.isfinite(baseline_variance) and baseline_variance > 0):
         raise InputError("baseline_variance", baseline_variance, "a positive variance (u^2)")
-    return central_moment(r, 4) / float(baseline_variance) ** 2
+    z, s = _deviation_scaled(_as_float_array(r, "r", min_size=2))
+    if not s > 0:
+        return 0.0
+    v = float(baseline_variance) / s / s  # v0 in the scaled unit
+    return float(np.mean(z**4)) / v**2 if v > 0 else math.inf
 
 
 class NA4Tracker:

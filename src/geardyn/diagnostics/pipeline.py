@@ -507,6 +507,10 @@ def _f(v):
 # --------------------------------------------------------------------------------------------
 # the chain
 # --------------------------------------------------------------------------------------------
+#: Largest signal magnitude the chain accepts (its squared quantities must stay in float64).
+MAX_SIGNAL_MAGNITUDE = 1e150
+
+
 def diagnose(
     signals: Mapping[str, np.ndarray],
     *,
@@ -591,6 +595,12 @@ def diagnose(
             raise InputError(f"signals[{name!r}]",
                              f"{bad.size} non-finite value(s), first at index {bad[0]}",
                              "finite numbers only (no NaN or inf)")
+        peak = float(np.max(np.abs(a))) if a.size else 0.0
+        if peak > MAX_SIGNAL_MAGNITUDE:
+            raise InputError(f"signals[{name!r}]", f"max |x| = {peak:.3g}",
+                             f"|x| <= {MAX_SIGNAL_MAGNITUDE:g} in its unit: the PWVD and the "
+                             "energy metrics are in unit^2, which float64 cannot hold beyond "
+                             "1e308 (rescale the signal, e.g. express it in another unit)")
         arrays[name] = a
     lengths = {a.shape[0] for a in arrays.values()}
     if len(lengths) != 1:
