@@ -26,6 +26,7 @@ CSV / text (``.csv``, ``.txt``, ``.tsv``, ``.dat``)
 
 from __future__ import annotations
 
+import contextlib
 import os
 import zipfile
 from dataclasses import dataclass, field
@@ -170,13 +171,12 @@ def _read_text(p: Path) -> DataTable:
         raise DataFileError(p, "a header but no data rows")
     ncol = len(head)
     data = None
-    try:  # fast path (C parser); the line loop below gives precise messages and NaN fields
+    # fast path (C parser); the line loop below gives precise messages and NaN fields
+    with contextlib.suppress(ValueError):
         fast = np.loadtxt(p, delimiter=delim, comments="#", ndmin=2, encoding="utf-8-sig",
                           skiprows=body[0][0] - 1, dtype=np.float64)
         if fast.shape == (len(body), ncol):
             data = fast
-    except ValueError:
-        pass
     if data is None:
         data = _parse_lines(p, body, ncol, split)
     names = header or [str(i) for i in range(ncol)]

@@ -140,12 +140,6 @@ class Report:
         self._body.append(
             f'<figure id="fig-{_slug(name)}"><img src="data:image/png;base64,{b64}" '
             f'alt="{cap}"><figcaption><b>Figure {self._n_fig}.</b> {cap}</figcaption></figure>')
-        try:  # free the figure's memory
-            import matplotlib.pyplot as plt
-
-            plt.close(fig)
-        except Exception:  # noqa: BLE001 - a Figure not managed by pyplot
-            pass
         return path
 
     def table(self, header: Sequence[str], rows: Iterable[Sequence[object]], caption: str = "",

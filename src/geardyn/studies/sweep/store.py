@@ -198,10 +198,8 @@ def store_status(out: str | os.PathLike, *, repair: bool = False) -> np.ndarray:
     """
     g = _open_group(Path(out), "r+" if repair else "r")
     arr = g["status"]
-    try:
+    with contextlib.suppress(Exception):  # a torn chunk: read chunk by chunk below
         return np.asarray(arr[:], dtype=np.int8)
-    except Exception:
-        pass
     n, b = arr.shape[0], arr.chunks[0]
     out_status = np.zeros(n, dtype=np.int8)
     for a in range(0, n, b):
