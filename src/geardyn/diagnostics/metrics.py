@@ -58,6 +58,7 @@ from scipy import fft as sfft
 
 from geardyn.errors import InputError
 
+from ..io import json_safe
 from .demodulation import band_limits
 from .spectra import difference, mesh_orders, regular, residual
 from .tsa import DiagnosticsWarning, _as_float_array, _check_int
@@ -151,7 +152,7 @@ class SignalStatistics:
 
     def to_dict(self) -> dict:
         """Plain dict of the fields (NaN as None)."""
-        return {k: _json_float(v) for k, v in asdict(self).items()}
+        return json_safe(asdict(self))
 
 
 def signal_statistics(x) -> SignalStatistics:
@@ -472,7 +473,7 @@ class ConditionMetrics:
 
     def to_dict(self) -> dict:
         """Plain dict keyed by the MATLAB column names (NaN as None, JSON-safe)."""
-        return {k: _json_float(v) for k, v in asdict(self).items()}
+        return json_safe(asdict(self))
 
 
 def condition_metrics(
@@ -550,10 +551,3 @@ def condition_metrics(
     )
 
 
-def _json_float(v):
-    if isinstance(v, (float, np.floating)):
-        v = float(v)
-        return v if math.isfinite(v) else None
-    if isinstance(v, np.integer):
-        return int(v)
-    return v

@@ -500,8 +500,10 @@ def _safe(name: str) -> str:
 
 
 def _f(v):
-    v = float(v)
-    return v if math.isfinite(v) else None
+    """A float for JSON: NaN and infinities become None (:func:`geardyn.io.json_safe`)."""
+    from ..io import json_safe
+
+    return json_safe(float(v))
 
 
 # --------------------------------------------------------------------------------------------
