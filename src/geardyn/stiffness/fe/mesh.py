@@ -33,6 +33,7 @@ strength (30 deg tangent critical section).
 from __future__ import annotations
 
 import math
+import threading
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -42,6 +43,11 @@ from ...geometry import Gear
 
 __all__ = ["MeshSettings", "CrackGeometry", "BodyMesh", "build_body_mesh", "loaded_flank",
            "critical_fillet_point", "crack_segment", "tooth_offsets"]
+
+#: Serialises every use of gmsh in this process. gmsh keeps one global model and is not
+#: thread-safe: two threads meshing at once (a Dask worker with several threads, say) crash the
+#: process. Held from ``gmsh.initialize`` to ``gmsh.finalize``.
+_GMSH_LOCK = threading.Lock()
 
 
 @dataclass(frozen=True)
@@ -274,182 +280,184 @@ def build_body_mesh(gear: Gear, settings: MeshSettings, crack: CrackGeometry | N
     if crack is not None:
         mouth, tip = crack_segment(gear, crack)
 
-    gmsh.initialize(["", "-nt", "1"], readConfigFiles=False, interruptible=False)
-    try:
-        gmsh.option.setNumber("General.Terminal", 0)
-        gmsh.option.setNumber("General.Verbosity", 1)
-        gmsh.option.setNumber("General.NumThreads", 1)
-        gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
-        gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
-        gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
-        gmsh.option.setNumber("Mesh.Algorithm", 6)
-        gmsh.option.setNumber("Mesh.RandomFactor", 1e-9)
-        gmsh.model.add("gear_body")
-        geo = gmsh.model.geo
-        lc = settings.body_size
+    # gmsh is a process-wide singleton and not thread-safe: one mesh at a time per process
+    with _GMSH_LOCK:
+        gmsh.initialize(["", "-nt", "1"], readConfigFiles=False, interruptible=False)
+        try:
+            gmsh.option.setNumber("General.Terminal", 0)
+            gmsh.option.setNumber("General.Verbosity", 1)
+            gmsh.option.setNumber("General.NumThreads", 1)
+            gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
+            gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
+            gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
+            gmsh.option.setNumber("Mesh.Algorithm", 6)
+            gmsh.option.setNumber("Mesh.RandomFactor", 1e-9)
+            gmsh.model.add("gear_body")
+            geo = gmsh.model.geo
+            lc = settings.body_size
 
-        def point(xy) -> int:
-            return geo.addPoint(float(xy[0]), float(xy[1]), 0.0, lc)
+            def point(xy) -> int:
+                return geo.addPoint(float(xy[0]), float(xy[1]), 0.0, lc)
 
-        centre = geo.addPoint(0.0, 0.0, 0.0, lc)
-        curves: list[int] = []
-        named: dict[str, list[int]] = {}
-        crack_mouth_tag = None
-        first_point = None
-        prev_end = None  # last point of the previous tooth (its loaded fillet on the root circle)
-        for k in range(z):
-            j = k if k <= z // 2 else k - z
-            refined = j in offsets
-            inv, fil = (inv_r, fil_r) if refined else (inv_c, fil_c)
-            rot = _rot(2 * math.pi * j / z)
-            # unloaded (clockwise, x > 0) side: mirror of the loaded one
-            r_fil = (rot @ (fil * [-1, 1]).T).T  # form -> root
-            r_inv = (rot @ (inv * [-1, 1]).T).T  # form -> tip
-            l_fil = (rot @ fil.T).T
-            l_inv = (rot @ inv.T).T
-            # points: right root -> right form -> right tip -> left tip -> left form -> left root
-            p_rroot = point(r_fil[-1])
-            p_rform = point(r_fil[0])
-            p_rtip = point(r_inv[-1])
-            p_ltip = point(l_inv[-1])
-            p_lform = point(l_fil[0])
-            p_lroot = point(l_fil[-1])
-            if first_point is None:
-                first_point = p_rroot
-            if prev_end is not None:
-                curves.append(geo.addCircleArc(prev_end, centre, p_rroot))
-            mid = [point(q) for q in r_fil[-2:0:-1]]
-            curves.append(geo.addSpline([p_rroot, *mid, p_rform]))
-            mid = [point(q) for q in r_inv[1:-1]]
-            curves.append(geo.addSpline([p_rform, *mid, p_rtip]))
-            tipc = geo.addCircleArc(p_rtip, centre, p_ltip)
-            curves.append(tipc)
-            mid = [point(q) for q in l_inv[-2:0:-1]]
-            flank = geo.addSpline([p_ltip, *mid, p_lform])
-            curves.append(flank)
-            if refined:
-                named[f"flank{j}"] = [flank]
-                named[f"tip{j}"] = [tipc]
-            if crack is not None and j == 0:
-                # split the loaded fillet at the crack mouth
-                pts = l_fil
-                d_m = np.hypot(*(pts - mouth).T)
-                i_m = int(np.argmin(d_m))
-                upper = [q for q in pts[1:i_m + 1] if np.hypot(*(q - mouth)) > 1e-3 * lc]
-                lower = [q for q in pts[i_m:-1] if np.hypot(*(q - mouth)) > 1e-3 * lc]
-                # keep each part on its side of the mouth (fillet ordered form -> root, radius
-                # decreasing)
-                rm = np.hypot(*mouth)
-                upper = [q for q in upper if np.hypot(*q) > rm]
-                lower = [q for q in lower if np.hypot(*q) < rm]
-                crack_mouth_tag = point(mouth)
-                c1 = geo.addSpline([p_lform, *[point(q) for q in upper], crack_mouth_tag])
-                c2 = geo.addSpline([crack_mouth_tag, *[point(q) for q in lower], p_lroot])
-                curves += [c1, c2]
-                named["fillet0"] = [c1, c2]
-            else:
-                mid = [point(q) for q in l_fil[1:-1]]
-                c = geo.addSpline([p_lform, *mid, p_lroot])
-                curves.append(c)
+            centre = geo.addPoint(0.0, 0.0, 0.0, lc)
+            curves: list[int] = []
+            named: dict[str, list[int]] = {}
+            crack_mouth_tag = None
+            first_point = None
+            prev_end = None  # last point of the previous tooth (its loaded fillet on the root circle)
+            for k in range(z):
+                j = k if k <= z // 2 else k - z
+                refined = j in offsets
+                inv, fil = (inv_r, fil_r) if refined else (inv_c, fil_c)
+                rot = _rot(2 * math.pi * j / z)
+                # unloaded (clockwise, x > 0) side: mirror of the loaded one
+                r_fil = (rot @ (fil * [-1, 1]).T).T  # form -> root
+                r_inv = (rot @ (inv * [-1, 1]).T).T  # form -> tip
+                l_fil = (rot @ fil.T).T
+                l_inv = (rot @ inv.T).T
+                # points: right root -> right form -> right tip -> left tip -> left form -> left root
+                p_rroot = point(r_fil[-1])
+                p_rform = point(r_fil[0])
+                p_rtip = point(r_inv[-1])
+                p_ltip = point(l_inv[-1])
+                p_lform = point(l_fil[0])
+                p_lroot = point(l_fil[-1])
+                if first_point is None:
+                    first_point = p_rroot
+                if prev_end is not None:
+                    curves.append(geo.addCircleArc(prev_end, centre, p_rroot))
+                mid = [point(q) for q in r_fil[-2:0:-1]]
+                curves.append(geo.addSpline([p_rroot, *mid, p_rform]))
+                mid = [point(q) for q in r_inv[1:-1]]
+                curves.append(geo.addSpline([p_rform, *mid, p_rtip]))
+                tipc = geo.addCircleArc(p_rtip, centre, p_ltip)
+                curves.append(tipc)
+                mid = [point(q) for q in l_inv[-2:0:-1]]
+                flank = geo.addSpline([p_ltip, *mid, p_lform])
+                curves.append(flank)
                 if refined:
-                    named[f"fillet{j}"] = [c]
-            prev_end = p_lroot
-        curves.append(geo.addCircleArc(prev_end, centre, first_point))
-        outer = geo.addCurveLoop(curves)
-        b = gear.bore_radius
-        pb = [point((b * math.cos(a), b * math.sin(a))) for a in (0, 2 * math.pi / 3,
-                                                                   4 * math.pi / 3)]
-        bore = [geo.addCircleArc(pb[i], centre, pb[(i + 1) % 3]) for i in range(3)]
-        named["bore"] = bore
-        inner = geo.addCurveLoop(bore)
-        surf = geo.addPlaneSurface([outer, inner])
-        crack_line = None
-        if crack is not None:
-            p_tip = geo.addPoint(float(tip[0]), float(tip[1]), 0.0, lc)
-            crack_line = geo.addLine(crack_mouth_tag, p_tip)
-        geo.synchronize()
-        if crack_line is not None:
-            gmsh.model.mesh.embed(1, [crack_line], 2, surf)
-            named["crack"] = [crack_line]
+                    named[f"flank{j}"] = [flank]
+                    named[f"tip{j}"] = [tipc]
+                if crack is not None and j == 0:
+                    # split the loaded fillet at the crack mouth
+                    pts = l_fil
+                    d_m = np.hypot(*(pts - mouth).T)
+                    i_m = int(np.argmin(d_m))
+                    upper = [q for q in pts[1:i_m + 1] if np.hypot(*(q - mouth)) > 1e-3 * lc]
+                    lower = [q for q in pts[i_m:-1] if np.hypot(*(q - mouth)) > 1e-3 * lc]
+                    # keep each part on its side of the mouth (fillet ordered form -> root, radius
+                    # decreasing)
+                    rm = np.hypot(*mouth)
+                    upper = [q for q in upper if np.hypot(*q) > rm]
+                    lower = [q for q in lower if np.hypot(*q) < rm]
+                    crack_mouth_tag = point(mouth)
+                    c1 = geo.addSpline([p_lform, *[point(q) for q in upper], crack_mouth_tag])
+                    c2 = geo.addSpline([crack_mouth_tag, *[point(q) for q in lower], p_lroot])
+                    curves += [c1, c2]
+                    named["fillet0"] = [c1, c2]
+                else:
+                    mid = [point(q) for q in l_fil[1:-1]]
+                    c = geo.addSpline([p_lform, *mid, p_lroot])
+                    curves.append(c)
+                    if refined:
+                        named[f"fillet{j}"] = [c]
+                prev_end = p_lroot
+            curves.append(geo.addCircleArc(prev_end, centre, first_point))
+            outer = geo.addCurveLoop(curves)
+            b = gear.bore_radius
+            pb = [point((b * math.cos(a), b * math.sin(a))) for a in (0, 2 * math.pi / 3,
+                                                                       4 * math.pi / 3)]
+            bore = [geo.addCircleArc(pb[i], centre, pb[(i + 1) % 3]) for i in range(3)]
+            named["bore"] = bore
+            inner = geo.addCurveLoop(bore)
+            surf = geo.addPlaneSurface([outer, inner])
+            crack_line = None
+            if crack is not None:
+                p_tip = geo.addPoint(float(tip[0]), float(tip[1]), 0.0, lc)
+                crack_line = geo.addLine(crack_mouth_tag, p_tip)
+            geo.synchronize()
+            if crack_line is not None:
+                gmsh.model.mesh.embed(1, [crack_line], 2, surf)
+                named["crack"] = [crack_line]
 
-        # ---- size fields
-        fld = gmsh.model.mesh.field
-        g = settings.growth
-        fields = []
-        flank_curves = [named[f"flank{j}"][0] for j in offsets]
-        hf, ht, hb = settings.flank_size, settings.tooth_size, settings.body_size
-        flen = (gear.outline(4, 4).involute[-1] - gear.outline(4, 4).involute[0])
-        sampling = int(min(20000, max(100, 4 * np.hypot(*flen) * 3 / hf)))
-        f1 = fld.add("Distance")
-        fld.setNumbers(f1, "CurvesList", flank_curves)
-        fld.setNumber(f1, "Sampling", sampling)
-        t1 = fld.add("Threshold")
-        fld.setNumber(t1, "InField", f1)
-        fld.setNumber(t1, "SizeMin", hf)
-        fld.setNumber(t1, "SizeMax", hb)
-        fld.setNumber(t1, "DistMin", 2 * hf)
-        fld.setNumber(t1, "DistMax", 2 * hf + (hb - hf) / (g - 1))
-        fields.append(t1)
-        tooth_curves = []
-        for j in offsets:
-            tooth_curves += named[f"flank{j}"] + named[f"tip{j}"] + named[f"fillet{j}"]
-        f2 = fld.add("Distance")
-        fld.setNumbers(f2, "CurvesList", tooth_curves)
-        fld.setNumber(f2, "Sampling", 400)
-        t2 = fld.add("Threshold")
-        fld.setNumber(t2, "InField", f2)
-        fld.setNumber(t2, "SizeMin", ht)
-        fld.setNumber(t2, "SizeMax", hb)
-        fld.setNumber(t2, "DistMin", gear.module)
-        fld.setNumber(t2, "DistMax", gear.module + (hb - ht) / (g - 1))
-        fields.append(t2)
-        if crack_line is not None:
-            f3 = fld.add("Distance")
-            fld.setNumbers(f3, "PointsList", [p_tip])
-            t3 = fld.add("Threshold")
-            fld.setNumber(t3, "InField", f3)
-            fld.setNumber(t3, "SizeMin", hf)
-            fld.setNumber(t3, "SizeMax", hb)
-            fld.setNumber(t3, "DistMin", 2 * hf)
-            fld.setNumber(t3, "DistMax", 2 * hf + (hb - hf) / (g - 1))
-            f4 = fld.add("Distance")
-            fld.setNumbers(f4, "CurvesList", [crack_line])
-            fld.setNumber(f4, "Sampling", 200)
-            t4 = fld.add("Threshold")
-            fld.setNumber(t4, "InField", f4)
-            fld.setNumber(t4, "SizeMin", min(ht, 4 * hf))
-            fld.setNumber(t4, "SizeMax", hb)
-            fld.setNumber(t4, "DistMin", 0.0)
-            fld.setNumber(t4, "DistMax", (hb - min(ht, 4 * hf)) / (g - 1) + hf)
-            fields += [t3, t4]
-        fmin = fld.add("Min")
-        fld.setNumbers(fmin, "FieldsList", fields)
-        fld.setAsBackgroundMesh(fmin)
+            # ---- size fields
+            fld = gmsh.model.mesh.field
+            g = settings.growth
+            fields = []
+            flank_curves = [named[f"flank{j}"][0] for j in offsets]
+            hf, ht, hb = settings.flank_size, settings.tooth_size, settings.body_size
+            flen = (gear.outline(4, 4).involute[-1] - gear.outline(4, 4).involute[0])
+            sampling = int(min(20000, max(100, 4 * np.hypot(*flen) * 3 / hf)))
+            f1 = fld.add("Distance")
+            fld.setNumbers(f1, "CurvesList", flank_curves)
+            fld.setNumber(f1, "Sampling", sampling)
+            t1 = fld.add("Threshold")
+            fld.setNumber(t1, "InField", f1)
+            fld.setNumber(t1, "SizeMin", hf)
+            fld.setNumber(t1, "SizeMax", hb)
+            fld.setNumber(t1, "DistMin", 2 * hf)
+            fld.setNumber(t1, "DistMax", 2 * hf + (hb - hf) / (g - 1))
+            fields.append(t1)
+            tooth_curves = []
+            for j in offsets:
+                tooth_curves += named[f"flank{j}"] + named[f"tip{j}"] + named[f"fillet{j}"]
+            f2 = fld.add("Distance")
+            fld.setNumbers(f2, "CurvesList", tooth_curves)
+            fld.setNumber(f2, "Sampling", 400)
+            t2 = fld.add("Threshold")
+            fld.setNumber(t2, "InField", f2)
+            fld.setNumber(t2, "SizeMin", ht)
+            fld.setNumber(t2, "SizeMax", hb)
+            fld.setNumber(t2, "DistMin", gear.module)
+            fld.setNumber(t2, "DistMax", gear.module + (hb - ht) / (g - 1))
+            fields.append(t2)
+            if crack_line is not None:
+                f3 = fld.add("Distance")
+                fld.setNumbers(f3, "PointsList", [p_tip])
+                t3 = fld.add("Threshold")
+                fld.setNumber(t3, "InField", f3)
+                fld.setNumber(t3, "SizeMin", hf)
+                fld.setNumber(t3, "SizeMax", hb)
+                fld.setNumber(t3, "DistMin", 2 * hf)
+                fld.setNumber(t3, "DistMax", 2 * hf + (hb - hf) / (g - 1))
+                f4 = fld.add("Distance")
+                fld.setNumbers(f4, "CurvesList", [crack_line])
+                fld.setNumber(f4, "Sampling", 200)
+                t4 = fld.add("Threshold")
+                fld.setNumber(t4, "InField", f4)
+                fld.setNumber(t4, "SizeMin", min(ht, 4 * hf))
+                fld.setNumber(t4, "SizeMax", hb)
+                fld.setNumber(t4, "DistMin", 0.0)
+                fld.setNumber(t4, "DistMax", (hb - min(ht, 4 * hf)) / (g - 1) + hf)
+                fields += [t3, t4]
+            fmin = fld.add("Min")
+            fld.setNumbers(fmin, "FieldsList", fields)
+            fld.setAsBackgroundMesh(fmin)
 
-        gmsh.model.mesh.generate(2)
+            gmsh.model.mesh.generate(2)
 
-        tags, coords, _ = gmsh.model.mesh.getNodes()
-        index = np.full(int(tags.max()) + 1, -1, dtype=np.int64)
-        index[tags.astype(np.int64)] = np.arange(tags.size)
-        p = coords.reshape(-1, 3)[:, :2].T.copy()
-        etypes, _, enodes = gmsh.model.mesh.getElements(2, surf)
-        tri = None
-        for et, en in zip(etypes, enodes, strict=True):
-            if et == 2:
-                tri = index[en.astype(np.int64)].reshape(-1, 3).T.copy()
-        if tri is None:
-            raise NumericalError("gmsh produced no triangles for the gear body")
-        edges: dict[str, np.ndarray] = {}
-        for name, tags_c in named.items():
-            segs = []
-            for c in tags_c:
-                et, _, en = gmsh.model.mesh.getElements(1, c)
-                for e, n in zip(et, en, strict=True):
-                    if e == 1:
-                        segs.append(index[n.astype(np.int64)].reshape(-1, 2).T)
-            edges[name] = np.hstack(segs) if segs else np.zeros((2, 0), dtype=np.int64)
-    finally:
-        gmsh.finalize()
+            tags, coords, _ = gmsh.model.mesh.getNodes()
+            index = np.full(int(tags.max()) + 1, -1, dtype=np.int64)
+            index[tags.astype(np.int64)] = np.arange(tags.size)
+            p = coords.reshape(-1, 3)[:, :2].T.copy()
+            etypes, _, enodes = gmsh.model.mesh.getElements(2, surf)
+            tri = None
+            for et, en in zip(etypes, enodes, strict=True):
+                if et == 2:
+                    tri = index[en.astype(np.int64)].reshape(-1, 3).T.copy()
+            if tri is None:
+                raise NumericalError("gmsh produced no triangles for the gear body")
+            edges: dict[str, np.ndarray] = {}
+            for name, tags_c in named.items():
+                segs = []
+                for c in tags_c:
+                    et, _, en = gmsh.model.mesh.getElements(1, c)
+                    for e, n in zip(et, en, strict=True):
+                        if e == 1:
+                            segs.append(index[n.astype(np.int64)].reshape(-1, 2).T)
+                edges[name] = np.hstack(segs) if segs else np.zeros((2, 0), dtype=np.int64)
+        finally:
+            gmsh.finalize()
 
     # drop unused nodes (the circle centre), renumber
     used = np.zeros(p.shape[1], bool)
