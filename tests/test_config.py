@@ -52,7 +52,9 @@ def test_round_trip_through_toml(tmp_path):
     c2 = load_case(p)
     assert c2 == c
     assert c2.provenance == c.provenance
-    assert "pinion.teeth" not in c2.provenance  # an override drops the paper's source
+    # an override replaces the paper's source by its origin (issue 13: it used to be dropped)
+    assert c2.provenance["pinion.teeth"] == "--set"
+    assert c2.provenance["pair.module"] == "paper Table 1"
 
 
 def test_overrides_parse_toml_values():

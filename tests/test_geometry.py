@@ -1,6 +1,6 @@
 """Geometry of the involute pair against closed-form values and the paper's numbers.
 
-Oracles: design/stiffness.md section 4.1 and design/dynamics.md "Checked numbers" (recomputed
+Oracles: docs/verification/geometry.md and docs/verification/dynamics.md "Static point" (recomputed
 from the paper's Table 1 with the corrected base radius, erratum 1).
 """
 

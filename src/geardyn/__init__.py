@@ -7,11 +7,10 @@ dynamics and gear diagnostics.
 
 from __future__ import annotations
 
+from ._version import __version__
 from .config import Case, load_case, paper_case
 from .errors import DataFileError, GeardynError, GeometryError, InputError, NumericalError
 from .geometry import Gear, GearPair, OperatingGeometry, centre_distance_from_displacements
-
-__version__ = "0.1.0"
 
 __all__ = [
     "__version__",

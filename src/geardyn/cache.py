@@ -1,14 +1,21 @@
 """Content-addressed on-disk cache with checksums and atomic writes.
 
 Entries are keyed by a hash of their inputs (the caller builds a JSON-serialisable description of
-everything the result depends on, including the geardyn version). Each entry is a file plus a
+everything the result depends on, including the geardyn version, and hashes it with
+:func:`cache_key`, the one hashing convention of geardyn's caches). Each entry is a file plus a
 ``.sha256`` sidecar holding the file's checksum and the inputs' key; a missing, truncated or
-corrupted entry fails the check, is deleted, and is rebuilt by the caller. Writes are atomic
-(temporary file, then rename), so two processes building the same entry at once leave one valid
-entry.
+corrupted entry fails the check, is deleted, and is rebuilt by the caller. The caller's ``load``
+may also refuse an entry whose content records other inputs (a stiffness map compares its stored
+``inputs_hash`` with the key): such an entry is rebuilt too. Writes are atomic (temporary file,
+then rename), so two processes building the same entry at once leave one valid entry; temporary
+files of killed builders are removed once stale (:func:`geardyn.io.remove_stale_temp_files`).
+Entries are locked with :mod:`filelock` (``fcntl.flock`` on POSIX, ``msvcrt.locking`` on
+Windows).
 
-The cache folder is ``$GEARDYN_CACHE_DIR`` if set, else ``~/.cache/geardyn``. Set
-``GEARDYN_NO_CACHE=1`` to bypass it.
+The cache folder is ``$GEARDYN_CACHE_DIR`` if set, else the platform's user cache folder from
+:func:`platformdirs.user_cache_dir` (``$XDG_CACHE_HOME/geardyn``, by default
+``~/.cache/geardyn``, on Linux; ``~/Library/Caches/geardyn`` on macOS;
+``%LOCALAPPDATA%\\geardyn\\Cache`` on Windows). Set ``GEARDYN_NO_CACHE=1`` to bypass it.
 """
 
 from __future__ import annotations
@@ -21,21 +28,32 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TypeVar
 
-from .io import write_bytes_atomic, write_text_atomic
+from .errors import DataFileError
+from .io import atomic_path, remove_stale_temp_files, write_bytes_atomic, write_text_atomic
 
-__all__ = ["cache_dir", "cache_key", "Cache", "default_cache"]
+__all__ = ["cache_dir", "cache_key", "Cache", "default_cache", "record_lookups"]
 
 T = TypeVar("T")
 
 
 def cache_dir() -> Path:
-    """The cache folder (``$GEARDYN_CACHE_DIR`` or ``~/.cache/geardyn``)."""
+    """The cache folder: ``$GEARDYN_CACHE_DIR``, else the platform's user cache folder for
+    ``geardyn`` (:func:`platformdirs.user_cache_dir`, which honours ``XDG_CACHE_HOME``)."""
     env = os.environ.get("GEARDYN_CACHE_DIR")
-    return Path(env) if env else Path.home() / ".cache" / "geardyn"
+    if env:
+        return Path(env)
+    from platformdirs import user_cache_dir
+
+    return Path(user_cache_dir("geardyn", appauthor=False))
 
 
 def cache_key(payload: object) -> str:
-    """SHA-256 (hex, 32 characters) of the canonical JSON of ``payload``."""
+    """SHA-256 (hex, 32 characters) of the canonical JSON of ``payload``.
+
+    Canonical: keys sorted, no spaces, UTF-8; what JSON cannot hold is written with ``repr``.
+    The one hashing convention of geardyn's caches and stores (stiffness maps, FE bodies, sweep
+    identities).
+    """
     text = json.dumps(payload, sort_keys=True, separators=(",", ":"), default=repr)
     return hashlib.sha256(text.encode("utf-8")).hexdigest()[:32]
 
@@ -50,19 +68,22 @@ def _sha256_file(path: Path) -> str:
 
 @contextlib.contextmanager
 def _entry_lock(path: Path):
-    """Exclusive advisory lock on ``<entry>.lock`` (POSIX ``flock``; no-op elsewhere)."""
-    path.parent.mkdir(parents=True, exist_ok=True)
+    """Exclusive lock on ``<entry>.lock`` (:class:`filelock.FileLock`: ``flock`` on POSIX,
+    ``msvcrt.locking`` on Windows), held while the entry is checked, built and stored."""
+    from filelock import FileLock
+
+    lock_path = path.with_name(path.name + ".lock")
     try:
-        import fcntl
-    except ImportError:  # pragma: no cover - not POSIX
+        path.parent.mkdir(parents=True, exist_ok=True)
+        lock = FileLock(str(lock_path))
+        lock.acquire()
+    except OSError as exc:
+        raise DataFileError(lock_path, f"cannot be used as the cache entry's lock ({exc}); "
+                                       "remove it, or set GEARDYN_NO_CACHE=1") from None
+    try:
         yield
-        return
-    with open(path.with_name(path.name + ".lock"), "a+") as fh:
-        fcntl.flock(fh.fileno(), fcntl.LOCK_EX)
-        try:
-            yield
-        finally:
-            fcntl.flock(fh.fileno(), fcntl.LOCK_UN)
+    finally:
+        lock.release()
 
 
 class Cache:
@@ -87,19 +108,37 @@ class Cache:
         return self.root / kind / f"{key}{suffix}"
 
     def valid(self, path: Path, key: str) -> bool:
-        """True if ``path`` exists and matches its sidecar checksum and key."""
+        """True if ``path`` is a readable file matching its sidecar checksum and key."""
         side = path.with_name(path.name + ".sha256")
+        if not (path.is_file() and side.is_file()):  # a folder, a FIFO (would block), a dangling link
+            return False
         try:
             meta = json.loads(side.read_text())
-            return meta.get("key") == key and meta.get("sha256") == _sha256_file(path)
+            return (isinstance(meta, dict) and meta.get("key") == key
+                    and meta.get("sha256") == _sha256_file(path))
         except (OSError, ValueError):
             return False
 
     def discard(self, path: Path) -> None:
-        """Delete an entry and its sidecar (missing files are fine)."""
+        """Delete an entry and its sidecar (missing files are fine).
+
+        Raises
+        ------
+        DataFileError
+            The entry or its sidecar is a folder, or cannot be deleted: the cache does not remove
+            what it did not write.
+        """
         for p in (path, path.with_name(path.name + ".sha256")):
-            with contextlib.suppress(FileNotFoundError):
+            if p.is_dir() and not p.is_symlink():
+                raise DataFileError(p, "is a folder where a cache entry belongs; remove it, or "
+                                       "set GEARDYN_NO_CACHE=1")
+            try:
                 p.unlink()
+            except FileNotFoundError:
+                continue
+            except OSError as exc:
+                raise DataFileError(p, f"is a damaged cache entry that cannot be removed ({exc}); "
+                                       "remove it, or set GEARDYN_NO_CACHE=1") from None
 
     def get_or_build(self, kind: str, key: str, suffix: str,
                      build: Callable[[], T], save: Callable[[T, Path], None],
@@ -120,7 +159,8 @@ class Cache:
             ``save(obj, path)`` writes the object to ``path`` (a temporary path; the cache renames
             it into place).
         load : callable
-            ``load(path)`` reads it back.
+            ``load(path)`` reads it back; it raises if the content is not what ``key`` describes
+            (e.g. a stored inputs hash that differs from ``key``), and the entry is rebuilt.
 
         Returns
         -------
@@ -134,30 +174,27 @@ class Cache:
         # and then loads its result, so concurrent runs do the work once and leave one valid
         # entry.
         with _entry_lock(path):
-            if path.exists():
+            remove_stale_temp_files(path.parent, path.name)
+            if path.exists() or path.with_name(path.name + ".sha256").exists():
                 if self.valid(path, key):
                     try:
-                        return load(path), True
-                    except Exception:  # unreadable despite checksum (format change): rebuild
-                        self.discard(path)
+                        obj = load(path)
+                        _note_lookup(kind, key, True)
+                        return obj, True
+                    except Exception:  # unreadable despite checksum (format change), or its
+                        self.discard(path)  # content records other inputs: rebuild
                 else:
                     self.discard(path)
             obj = build()
             self.store(obj, path, key, save)
+        _note_lookup(kind, key, False)
         return obj, False
 
     def store(self, obj: object, path: Path, key: str, save: Callable[[object, Path], None]) -> None:
         """Write ``obj`` to ``path`` atomically, then its sidecar."""
-        path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp{path.suffix}")
-        try:
+        with atomic_path(path, suffix=path.suffix) as tmp:
             save(obj, tmp)
             digest = _sha256_file(tmp)
-            os.replace(tmp, path)
-        except BaseException:
-            with contextlib.suppress(FileNotFoundError):
-                tmp.unlink()
-            raise
         write_text_atomic(path.with_name(path.name + ".sha256"),
                           json.dumps({"key": key, "sha256": digest}))
 
@@ -169,6 +206,31 @@ class Cache:
         write_text_atomic(path.with_name(path.name + ".sha256"),
                           json.dumps({"key": key, "sha256": hashlib.sha256(data).hexdigest()}))
         return path
+
+
+#: Active lookup recorders (see :func:`record_lookups`); each is a list of dicts.
+_RECORDERS: list[list[dict]] = []
+
+
+def _note_lookup(kind: str, key: str, hit: bool) -> None:
+    for rec in _RECORDERS:
+        rec.append({"kind": kind, "key": key, "hit": hit})
+
+
+@contextlib.contextmanager
+def record_lookups():
+    """Collect this process's :meth:`Cache.get_or_build` lookups while the block runs.
+
+    Yields a list that receives one ``{"kind", "key", "hit"}`` dict per lookup (``hit`` is True
+    when the entry was loaded from the cache, False when it was built). The command-line tool
+    writes it into its output folder's ``inputs.json``, so a re-run shows what it reused.
+    """
+    rec: list[dict] = []
+    _RECORDERS.append(rec)
+    try:
+        yield rec
+    finally:
+        _RECORDERS.remove(rec)
 
 
 def default_cache() -> Cache:

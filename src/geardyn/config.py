@@ -9,6 +9,18 @@ where it comes from; the shipped paper case does this for every entry, and the s
 
 Overrides use dotted keys, ``--set pinion.teeth=25`` or ``--set simulation.dt="5e-6 s"``; the
 value is read as a TOML value when it parses as one, otherwise as a string.
+
+Partial case files (issue 13): a file gives only what it changes over a base case, ``extends =
+"xue_howard"`` (the default), another shipped case, or another case file relative to it (chains
+up to :data:`MAX_EXTENDS`, cycles refused); ``extends = false`` marks a complete case (what
+:func:`case_to_toml` writes). Values from a base keep their source, values of an extending file
+without a source get the file's path, overrides get ``"--set"``; :func:`load_case_details` also
+keeps the values as written and each value's origin for ``geardyn config show``.
+
+Bounded input (issue 19): a case file must be a regular file of at most :data:`MAX_CASE_BYTES`
+bytes of UTF-8, nested at most :data:`MAX_NESTING` deep; ``--set`` values at most
+:data:`MAX_OVERRIDE_CHARS` characters; user strings (names, descriptions, sources) may not hold
+control characters (tab excepted). Case files are written with tomli-w.
 """
 
 from __future__ import annotations
@@ -17,8 +29,12 @@ import copy
 import functools
 import json
 import math
+import re
+import stat
 import tomllib
-from collections.abc import Iterable, Mapping
+import typing
+from collections.abc import Iterable, Iterator, Mapping
+from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
 from typing import Annotated, Any, Literal
@@ -45,6 +61,15 @@ __all__ = [
     "case_schema",
     "parse_overrides",
     "PAPER_CASE",
+    "CaseDetails",
+    "load_case_details",
+    "case_to_display_toml",
+    "read_case_text",
+    "parse_case_toml",
+    "check_text",
+    "shipped_cases",
+    "MAX_CASE_BYTES",
+    "MAX_NESTING",
 ]
 
 PAPER_CASE = "xue_howard"
@@ -65,6 +90,7 @@ def _quantity(dimension: str):
         "description": f"{dim.name}: a number in {dim.si_unit} or a string with a unit, "
                        f"e.g. {dim.example!r}",
         "x-unit": dim.si_unit,
+        "x-dimension": dim.name,
     }
     return Annotated[float, BeforeValidator(parse), WithJsonSchema(schema)]
 
@@ -158,6 +184,20 @@ class MotorConfig(_Model):
                                                                      "torque [N m].")
     breakdown_slip: float | None = Field(None, gt=0, lt=1, description="Induction law: slip at "
                                                                         "breakdown [-].")
+    ripple: float = Field(0.0, ge=0, lt=1, description="Input torque ripple amplitude as a "
+                          "fraction of the mean input torque [-] (0: none; issue 14.3).")
+    ripple_order: float = Field(1.0, gt=0, le=1000, description="Ripple cycles per motor "
+                                                                "revolution [-].")
+    ripple_phase: Angle = Field(0.0, description="Phase of the ripple [rad].")
+    profile_times: list[float] | None = Field(
+        None, description="Speed profile (issue 14.3): times [s], strictly increasing; with "
+                          "profile_speeds a piecewise-linear target motor speed, constant beyond "
+                          "the ends (two points: a ramp run-up or coast-down). Omit for none.")
+    profile_speeds: list[float] | None = Field(None, description="Speed profile: target motor "
+                                                                 "speeds [rad/s].")
+    drive_gain: TorsionalDamping = Field(
+        5.0, gt=0, description="Speed-controlled drive with a profile: T_in = T + gain "
+                               "(w_target(t) - w_m) [N m s/rad].")
 
     @model_validator(mode="after")
     def _induction_fields(self) -> MotorConfig:
@@ -181,9 +221,9 @@ class LoadConfig(_Model):
     coefficient: float | None = Field(
         None, gt=0, description="Law coefficient, SI (N m s/rad linear, N m s^2/rad^2 quadratic, "
                                 "N m constant); omit to calibrate from 'speed'.")
-    table_speeds: list[float] | None = Field(None, description="'table' law: output speeds "
-                                                                "[rad/s], increasing.")
-    table_torques: list[float] | None = Field(None, description="'table' law: torques [N m].")
+    table_speeds: list[AngularVelocity] | None = Field(
+        None, description="'table' law: output speeds [rad/s], increasing.")
+    table_torques: list[Torque] | None = Field(None, description="'table' law: torques [N m].")
 
     @model_validator(mode="after")
     def _law_fields(self) -> LoadConfig:
@@ -251,6 +291,10 @@ class StiffnessConfig(_Model):
                                                   "between bore and root circle in series with "
                                                   "the mesh (hub-to-hub stiffness, as FE and the "
                                                   "paper's FEA report it).")
+    foundation_half_angle: Literal["fillet", "ross", "alpha3"] | Angle = Field(
+        "fillet", description="PEM: root half-angle theta_f of the Sainsot foundation term: "
+                              "'fillet' (the generated tooth, 3.013/z), 'ross' (ROSS's 2.831/z), "
+                              "'alpha3' (Wan et al.'s root rectangle) or an angle.")
     fe: FEConfig = Field(default_factory=FEConfig)
 
     @model_validator(mode="after")
@@ -272,6 +316,9 @@ class SimulationConfig(_Model):
                                                      "[s].")
     record_time: Time = Field(1.0, gt=0, description="Recorded time [s].")
     decimation: int = Field(1, ge=1, strict=True, description="Keep every n-th step.")
+    max_steps: float = Field(1e8, gt=0, description="Largest number of time steps (settle plus "
+                                                    "record) a simulation may take; a longer one "
+                                                    "is refused before it starts [-].")
     tolerance: Length = Field(1e-7, gt=0, description="Model II: |b1 - b2| centre distance "
                                                       "tolerance [m] (paper: 0.1 um).")
     rtol: float = Field(1e-9, gt=0, lt=1, description="Model II: relative tolerance on the "
@@ -299,6 +346,105 @@ class DiagnosticsConfig(_Model):
         "paper", description="Which orders the residual removes.")
 
 
+class MeasurementConfig(_Model):
+    """What a housing accelerometer and a tachometer record (geardyn.measurement, issue 14)."""
+
+    fs: _quantity("frequency") = Field(50_000.0, gt=0, description="DAQ sample rate [Hz]; a "
+                                       "simple fraction of the simulation rate 1/(dt decimation).")
+    mode_frequencies: list[_quantity("frequency")] = Field(
+        [3000.0], description="Transfer path: natural frequency of each housing mode [Hz] (0 = "
+                              "rigid-body mode); ignored with frf_table.")
+    mode_damping_ratios: list[float] = Field([0.05], description="Damping ratio of each mode [-].")
+    mode_gains: list[list[float]] = Field(
+        [[0.05, 0.1]], description="Gain of each mode per bearing [pinion, gear] [(m/s^2)/N]: "
+                                   "the accelerance far above the mode (mode shapes at sensor "
+                                   "and bearing over the modal mass).")
+    frf_table: str | None = Field(None, description="Transfer path as a measured FRF: a CSV of "
+                                  "frequency [Hz] then re, im per bearing [(m/s^2)/N].")
+    frf_settling_time: _quantity("time") = Field(0.1, ge=0, description="Memory of the FRF "
+                                                 "table's path, discarded as lead-in [s].")
+    accelerometer_resonance: _quantity("frequency") | None = Field(
+        None, gt=0, description="Mounted resonance of the accelerometer [Hz]; omit for a flat "
+                                "sensor.")
+    accelerometer_damping_ratio: float = Field(0.02, gt=0, lt=1, description="Its damping "
+                                                                              "ratio [-].")
+    antialias_cutoff: _quantity("frequency") | None = Field(
+        None, gt=0, description="Anti-alias filter cutoff [Hz] (zero-phase Butterworth "
+                                "magnitude); omit for 0.4 fs (antialias_order = 0: no filter).")
+    antialias_order: int = Field(8, ge=0, le=64, strict=True, description="Butterworth order "
+                                                                          "(0 = no filter) [-].")
+    adc_bits: int = Field(24, ge=0, le=32, strict=True, description="ADC resolution [bits], "
+                                                                    "2..32; 0 = no quantisation.")
+    adc_range: _quantity("acceleration") = Field(50 * 9.80665, gt=0, description="ADC range "
+                                                 "+/- [m/s^2]; larger samples are clipped.")
+    snr: float | None = Field(20.0, description="Signal-to-noise ratio [dB], >= 0 (signal "
+                                                "variance over noise variance); inf = no noise.")
+    noise_level: _quantity("acceleration") | None = Field(
+        None, ge=0, description="Noise RMS [m/s^2], instead of snr.")
+    seed: int = Field(0, ge=0, strict=True, description="Seed of the noise and the tachometer "
+                                                        "jitter.")
+    tach_shaft: Literal["pinion", "gear"] = Field("pinion", description="Shaft the tachometer "
+                                                                        "reads.")
+    tach_pulses_per_rev: int = Field(1, ge=1, le=10_000, strict=True,
+                                     description="Tachometer pulses per revolution [-].")
+    tach_jitter: _quantity("time") = Field(0.0, ge=0, description="Trigger jitter, standard "
+                                                                  "deviation [s].")
+    tach_offset: Angle = Field(0.0, description="Shaft angle of pulse 0 [rad].")
+    tach_amplitude: float = Field(5.0, gt=0, description="Pulse height [V].")
+    tach_rise_time: _quantity("time") | None = Field(None, ge=0, description="Pulse edge "
+                                                     "duration [s]; omit for 3 / fs.")
+
+    @model_validator(mode="after")
+    def _modes(self) -> MeasurementConfig:
+        n = len(self.mode_frequencies)
+        if self.frf_table is None and not (n >= 1 and len(self.mode_damping_ratios) == n
+                                           and len(self.mode_gains) == n):
+            raise ValueError("measurement.mode_frequencies, mode_damping_ratios and mode_gains "
+                             f"must have the same length >= 1 (got {n}, "
+                             f"{len(self.mode_damping_ratios)}, {len(self.mode_gains)})")
+        if self.frf_table is None and any(len(g) != 2 for g in self.mode_gains):
+            raise ValueError("measurement.mode_gains: two gains per mode, [pinion, gear] "
+                             "bearing, in (m/s^2)/N")
+        return self
+
+
+class GearErrorsConfig(_Model):
+    """Tooth errors and tip relief of one gear (geardyn.modifications); all off by default.
+
+    Deviations are along the line of action, positive where material is missing."""
+
+    grade: int | None = Field(None, ge=1, le=11, strict=True, description="ISO 1328-1:2013 "
+                              "flank tolerance class 1-11 to draw pitch and profile deviations "
+                              "from; omit for none.")
+    seed: int = Field(0, ge=0, strict=True, description="Seed of the drawn deviations.")
+    fraction: float = Field(1.0, gt=0, le=1, description="Drawn deviations span this fraction "
+                            "of the class's tolerances (cumulative pitch = fraction * F_pT) [-].")
+    cumulative_pitch: list[float] | None = Field(None, description="Table: cumulative pitch "
+                                                 "deviation of each tooth on the reference circle "
+                                                 "[m] (replaces the drawn one).")
+    profile_slope: list[float] | None = Field(None, description="Table: profile slope deviation "
+                                              "f_Halpha of each tooth [m].")
+    profile_form: list[float] | None = Field(None, description="Table: profile form deviation "
+                                             "f_falpha (peak-to-valley) of each tooth [m].")
+    form_waves: float = Field(2.0, gt=0, le=50, description="Waves of the form deviation over "
+                              "the active profile [-].")
+    runout: Length = Field(0.0, ge=0, description="Eccentricity (runout amplitude along the LOA) "
+                           "[m].")
+    runout_phase: Angle = Field(0.0, description="Phase of the eccentricity [rad].")
+    tip_relief: Length = Field(0.0, ge=0, description="Tip relief amount C_a at the tip [m].")
+    relief_start: Angle | None = Field(None, description="Roll angle where the relief starts "
+                                       "[rad]; omit for the highest point of single tooth "
+                                       "contact.")
+    relief_shape: Literal["linear", "parabolic"] = Field("linear", description="Relief shape.")
+
+
+class ModificationsConfig(_Model):
+    """Tooth errors and relief of both gears (a missing section: perfect involutes)."""
+
+    pinion: GearErrorsConfig = Field(default_factory=GearErrorsConfig)
+    gear: GearErrorsConfig = Field(default_factory=GearErrorsConfig)
+
+
 class Case(_Model):
     """A complete geardyn case: the gear pair, its supports and loads, and the study settings."""
 
@@ -314,11 +460,22 @@ class Case(_Model):
     output_coupling: CouplingConfig
     mesh: MeshConfig = Field(default_factory=MeshConfig)
     crack: CrackConfig | None = None
+    modifications: ModificationsConfig | None = None
     stiffness: StiffnessConfig = Field(default_factory=StiffnessConfig)
     simulation: SimulationConfig = Field(default_factory=SimulationConfig)
     diagnostics: DiagnosticsConfig = Field(default_factory=DiagnosticsConfig)
+    measurement: MeasurementConfig | None = Field(None, description="Sensor chain for "
+                                                  "'geardyn measure'; omit for its defaults.")
     provenance: dict[str, str] = Field(default_factory=dict,
                                        description="Source of each value, by dotted key.")
+
+    @field_validator("name", "description")
+    @classmethod
+    def _printable(cls, v: str) -> str:
+        m = _CONTROL.search(v)
+        if m is not None:
+            raise ValueError(_control_message(m))
+        return v
 
     # ----------------------------------------------------------------- derived objects
     def gear_pair(self):
@@ -344,30 +501,346 @@ class Case(_Model):
 
         return GearPair(make(self.pinion, "pinion"), make(self.gear, "gear"))
 
-    def with_overrides(self, overrides: Mapping[str, Any] | Iterable[str]) -> Case:
-        """A new case with dotted-key overrides applied (validated again)."""
+    def with_overrides(self, overrides: Mapping[str, Any] | Iterable[str],
+                       source: str = "override") -> Case:
+        """A new case with dotted-key overrides applied (validated again).
+
+        The overridden values get ``source`` as their provenance (the CLI's ``--set`` goes
+        through :func:`load_case`, which records ``"--set"``).
+        """
         data = self.model_dump(mode="python")
         prov = data.pop("provenance")
         ov = parse_overrides(overrides) if not isinstance(overrides, Mapping) else overrides
         for key, value in ov.items():
             _set_dotted(data, key, value)
-            prov.pop(key, None)
+            _drop_under(prov, key)
+            if key not in _UNSOURCED:
+                prov[key] = source
         data["provenance"] = prov
         return _validate(data, source="overrides")
 
 
 # --------------------------------------------------------------------------- loading
+#: Largest case file read [bytes]; a larger file (or a device such as /dev/zero) is refused before
+#: it is parsed. The paper's case is about 10 kB; tomllib reads 256 kB of the worst text (a
+#: 100,000-element array, 25,000 tables) in well under 2 s.
+MAX_CASE_BYTES = 256 * 1024
+#: Deepest nesting of arrays/tables in a case file (the paper's case needs 5).
+MAX_NESTING = 16
+#: Longest chain of ``extends`` (a file extending a file extending ...).
+MAX_EXTENDS = 8
+#: Longest ``--set`` value [characters].
+MAX_OVERRIDE_CHARS = 10_000
+#: Keys of a ``{ value = ..., source = ... }`` table (``si`` and ``origin`` are written by
+#: ``geardyn config show`` for the reader and ignored on loading).
+_META_KEYS = frozenset({"value", "source", "note", "si", "origin"})
+#: Source shown by ``config show`` for a value nobody gave (the field's built-in default).
+DEFAULT_SOURCE = "geardyn default (built-in value of the field)"
+#: Source (and origin) of a command-line override.
+SET_SOURCE = "--set"
+_UNSOURCED = frozenset({"name", "description"})
+# control characters refused in user strings: C0 except tab, DEL, C1
+# (and lone surrogates: bytes that were not UTF-8, e.g. in a command-line argument)
+_CONTROL = re.compile(r"[\x00-\x08\x0a-\x1f\x7f-\x9f\ud800-\udfff]")
+_KEY_PART = r'(?:[A-Za-z0-9_-]+|"[^"\n]{0,200}"|\'[^\'\n]{0,200}\')'
+# a dotted key of more than MAX_NESTING parts at a line start, after '[' or '{' or ',' (tomllib
+# takes quadratic time in the number of parts: 8000 parts take seconds)
+_DEEP_KEY = re.compile(r"(?:^|[\[{,])[ \t]*" + _KEY_PART + r"(?:[ \t]*\.[ \t]*" + _KEY_PART
+                       + r"){16,}", re.M)
+_SCAN = re.compile(r'"""|\'\'\'|["\'#\[\]{}]')
+_BASIC_END = re.compile(r'(?:[^"\\\n]|\\.)*"')
+_ML_BASIC_END = re.compile(r'(?:[^"\\]|\\.|"(?!""))*"""', re.S)
+
+
+def _control_message(m: re.Match) -> str:
+    code = ord(m.group(0))
+    if 0xD800 <= code <= 0xDFFF:
+        return (f"UTF-8 text (found a byte that is not UTF-8 at position {m.start()}, shown as "
+                f"U+{code:04X}); no control characters")
+    return (f"text without control characters (found U+{code:04X} at position {m.start()}; "
+            "tab is allowed)")
+
+
+def check_text(value: Any, field: str) -> None:
+    """Refuse control characters (other than tab) in a user string, naming the field.
+
+    Raises
+    ------
+    InputError
+        If ``value`` is a string holding a character U+0000-U+0008, U+000A-U+001F, U+007F or
+        U+0080-U+009F.
+    """
+    if isinstance(value, str):
+        m = _CONTROL.search(value)
+        if m is not None:
+            raise InputError(field, value, _control_message(m))
+
+
+def _check_strings(node: Any, prefix: str) -> None:
+    """:func:`check_text` on every string (keys and values) of raw case data."""
+    stack = [(node, prefix)]
+    while stack:
+        obj, key = stack.pop()
+        if isinstance(obj, dict):
+            for k, v in obj.items():
+                sub = f"{key}.{k}" if key else str(k)
+                check_text(k, sub)
+                stack.append((v, sub))
+        elif isinstance(obj, list):
+            stack.extend((v, f"{key}[{i}]") for i, v in enumerate(obj))
+        else:
+            check_text(obj, key)
+
+
+def read_case_text(path: str | Path, kind: str = "case file", limit: int = MAX_CASE_BYTES) -> str:
+    """Read a case file as UTF-8 text, bounded in size and time.
+
+    Refuses (with :class:`DataFileError` naming the file) a missing file, a directory, anything
+    that is not a regular file (``/dev/zero``, a pipe, a socket: they could stream for ever), a
+    file larger than ``limit`` bytes (checked before and while reading), and bytes that are not
+    UTF-8 (with the offset of the first bad byte).
+    """
+    p = Path(path)
+    try:
+        st = p.stat()
+    except FileNotFoundError:
+        raise DataFileError(p, "no such file") from None
+    except OSError as exc:
+        raise DataFileError(p, f"cannot be read ({exc.strerror or exc})") from None
+    if stat.S_ISDIR(st.st_mode):
+        raise DataFileError(p, f"is a directory, not a {kind}")
+    if not stat.S_ISREG(st.st_mode):
+        raise DataFileError(p, f"is not a regular file (a device, pipe or socket), not a {kind}")
+    too_big = f"is larger than {limit} bytes, the limit for a {kind}"
+    if st.st_size > limit:
+        raise DataFileError(p, too_big)
+    try:
+        with open(p, "rb") as fh:
+            data = fh.read(limit + 1)
+    except OSError as exc:
+        raise DataFileError(p, f"cannot be read ({exc.strerror or exc})") from None
+    if len(data) > limit:
+        raise DataFileError(p, too_big)
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise DataFileError(p, f"is not UTF-8 text (byte 0x{data[exc.start]:02x} at offset "
+                               f"{exc.start}); save it as UTF-8") from None
+
+
+def _nesting(text: str) -> int:
+    """Deepest bracket nesting (``[``/``{``) outside strings and comments of TOML text.
+
+    One linear pass that jumps between brackets, quotes and comments; it stops counting once
+    :data:`MAX_NESTING` is passed.
+    """
+    i, n, depth, deepest = 0, len(text), 0, 0
+    while i < n:
+        m = _SCAN.search(text, i)
+        if m is None:
+            break
+        t, i = m.group(0), m.end()
+        if t == "#":
+            j = text.find("\n", i)
+            i = n if j < 0 else j
+        elif t == '"""':
+            e = _ML_BASIC_END.match(text, i)
+            i = n if e is None else e.end()
+        elif t == "'''":
+            j = text.find("'''", i)
+            i = n if j < 0 else j + 3
+        elif t == '"':
+            e = _BASIC_END.match(text, i)
+            i = (text.find("\n", i) if e is None else e.end())
+            i = n if i < 0 else i
+        elif t == "'":
+            j = text.find("'", i)
+            i = n if j < 0 else j + 1
+        elif t in "[{":
+            depth += 1
+            deepest = max(deepest, depth)
+            if deepest > MAX_NESTING:
+                break
+        else:
+            depth = max(0, depth - 1)
+    return deepest
+
+
+def _tree_depth(node: Any) -> int:
+    """Depth of nested dicts/lists (iterative: safe for any depth)."""
+    deepest, stack = 0, [(node, 1)]
+    while stack:
+        obj, d = stack.pop()
+        if isinstance(obj, dict | list):
+            deepest = max(deepest, d)
+            if deepest > MAX_NESTING + 8:
+                return deepest
+            stack.extend((v, d + 1) for v in (obj.values() if isinstance(obj, dict) else obj))
+    return deepest
+
+
+def parse_case_toml(text: str, origin: str) -> dict[str, Any]:
+    """Parse case-file text with :mod:`tomllib`, refusing deep nesting and huge numbers first.
+
+    Raises
+    ------
+    DataFileError
+        Naming ``origin``: not valid TOML, nested deeper than :data:`MAX_NESTING`, or a number
+        Python refuses to convert (more than 4300 digits).
+    """
+    if _nesting(text) > MAX_NESTING:
+        raise DataFileError(origin, f"nests arrays or tables deeper than {MAX_NESTING} levels")
+    if _DEEP_KEY.search(text) is not None:
+        raise DataFileError(origin, f"nests keys deeper than {MAX_NESTING} levels (a dotted key "
+                                    f"of more than {MAX_NESTING} parts)")
+    try:
+        raw = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise DataFileError(origin, f"is not valid TOML: {exc}") from None
+    except (ValueError, RecursionError, MemoryError) as exc:
+        raise DataFileError(origin, f"cannot be read as TOML ({type(exc).__name__}: a number too "
+                                    "long or values nested too deeply)") from None
+    if _tree_depth(raw) > MAX_NESTING + 8:
+        raise DataFileError(origin, f"nests keys deeper than {MAX_NESTING + 8} levels")
+    return raw
+
+
 def _extract_provenance(node: Any, prefix: str, out: dict[str, str]) -> Any:
     """Replace ``{value = v, source = s}`` tables by ``v``, recording ``s`` at the dotted key."""
     if isinstance(node, dict):
         keys = set(node)
-        if "value" in keys and keys <= {"value", "source", "note"}:
+        if "value" in keys and keys <= _META_KEYS:
             if "source" in node:
-                out[prefix] = str(node["source"]) + (f" ({node['note']})" if "note" in node else "")
+                src = node["source"]
+                if not isinstance(src, str):
+                    raise InputError(f"{prefix}.source", src, "a text naming where the value "
+                                                              "comes from")
+                check_text(src, f"{prefix}.source")
+                note = node.get("note")
+                check_text(note, f"{prefix}.note")
+                out[prefix] = src + (f" ({note})" if note is not None else "")
             return node["value"]
+        if "value" in keys and "source" in keys:  # a { value, source } table with a typo
+            bad = sorted(str(k) for k in keys - _META_KEYS)[0]
+            raise InputError(f"{prefix}.{bad}", node[bad], "a known key; unknown key here. "
+                             f"Allowed keys in a {{ value, source }} table: "
+                             f"{', '.join(sorted(_META_KEYS))}")
         return {k: _extract_provenance(v, f"{prefix}.{k}" if prefix else k, out)
                 for k, v in node.items()}
     return node
+
+
+def _leaves(node: Any, prefix: str = "") -> Iterator[tuple[str, Any]]:
+    """``(dotted key, value)`` of every non-table value of plain case data."""
+    for k, v in node.items():
+        key = f"{prefix}.{k}" if prefix else str(k)
+        if isinstance(v, dict) and v:
+            yield from _leaves(v, key)
+        else:
+            yield key, v
+
+
+def _drop_under(mapping: dict[str, str], key: str) -> None:
+    for k in [k for k in mapping if k == key or k.startswith(key + ".")]:
+        del mapping[k]
+
+
+def _merge(base: dict[str, Any], top: Mapping[str, Any]) -> dict[str, Any]:
+    """``top`` over ``base``: tables merge key by key, anything else replaces."""
+    out = dict(base)
+    for k, v in top.items():
+        if isinstance(v, dict) and isinstance(out.get(k), dict):
+            out[k] = _merge(out[k], v)
+        else:
+            out[k] = copy.deepcopy(v)
+    return out
+
+
+def shipped_cases() -> list[str]:
+    """Names of the cases shipped with geardyn (usable as ``extends = "<name>"``)."""
+    return sorted(f.name[:-5] for f in resources.files("geardyn.cases").iterdir()
+                  if f.name.endswith(".toml") and not f.name.startswith("sweep_"))
+
+
+@dataclass
+class _Layers:
+    """Raw case data (values as written) merged over its bases, with sources and origins."""
+
+    data: dict[str, Any]
+    prov: dict[str, str]
+    origin: dict[str, str]
+
+
+def _shipped_layer(name: str, chain: tuple[str, ...]) -> _Layers:
+    label = f"geardyn/cases/{name}.toml"
+    text = resources.files("geardyn.cases").joinpath(f"{name}.toml").read_text("utf-8")
+    return _layer_from_text(text, label, None, chain + (label,))
+
+
+def _file_layer(path: Path, chain: tuple[str, ...]) -> _Layers:
+    try:
+        ident = str(path.resolve())
+    except (OSError, RuntimeError):
+        ident = str(path)
+    if ident in chain:
+        raise InputError("extends", str(path), "a base case that does not extend itself "
+                                               "(cycle: " + " -> ".join(chain[-3:]) + ")")
+    text = read_case_text(path)
+    label = _CONTROL.sub("?", str(path))  # the file's name as a source: printable
+    return _layer_from_text(text, label, path, chain + (ident,))
+
+
+def _layer_from_text(text: str, label: str, path: Path | None, chain: tuple[str, ...]) -> _Layers:
+    raw = parse_case_toml(text, label)
+    prov: dict[str, str] = {}
+    data = _extract_provenance(raw, "", prov)
+    explicit = data.pop("provenance", None)
+    if explicit is not None:
+        if not isinstance(explicit, dict) or not all(isinstance(v, str) for v in explicit.values()):
+            raise InputError("provenance", explicit, "a table of dotted key = \"source text\"")
+        _check_strings(explicit, "provenance")
+        prov = {**explicit, **prov}
+    extends = data.pop("extends", PAPER_CASE if path is not None else False)
+    complete = extends is False or extends == "none"
+    if complete:
+        base = _Layers({}, {}, {})
+    elif not isinstance(extends, str) or not extends.strip():
+        raise InputError("extends", extends, "the name of a shipped case "
+                                             f"({', '.join(shipped_cases())}), a case file "
+                                             "relative to this one, or false for a complete case")
+    else:
+        if len(chain) > MAX_EXTENDS:
+            raise InputError("extends", extends, f"a chain of at most {MAX_EXTENDS} base cases")
+        check_text(extends, "extends")
+        if "/" not in extends and not extends.endswith(".toml") and extends in shipped_cases():
+            base = _shipped_layer(extends, chain)
+        else:
+            bp = Path(extends)
+            if not bp.is_absolute():
+                bp = (path.parent if path is not None else Path.cwd()) / bp
+            if not bp.exists():
+                raise InputError("extends", extends,
+                                 f"a shipped case ({', '.join(shipped_cases())}) or a case file "
+                                 f"relative to {label} (no file {bp})")
+            base = _file_layer(bp, chain)
+        if path is not None:  # the user's case keeps its own name, never its base's
+            stem = _CONTROL.sub("?", path.stem)
+            data.setdefault("name", stem)
+            data.setdefault("description", f"{stem}: changes to {extends}")
+    _check_strings(data, "")
+    merged = _merge(base.data, data)
+    sources, origins = dict(base.prov), dict(base.origin)
+    for key, _ in _leaves(data):
+        if key in _UNSOURCED:
+            continue
+        _drop_under(sources, key)
+        _drop_under(origins, key)
+        if key in prov or not complete:  # a complete file's own values need no file source
+            sources[key] = prov.get(key, label)
+        origins[key] = label
+    for key, src in prov.items():  # sources given in a [provenance] table for inner keys
+        sources.setdefault(key, src)
+    return _Layers(merged, sources, origins)
 
 
 def _set_dotted(data: dict, key: str, value: Any) -> None:
@@ -377,7 +850,8 @@ def _set_dotted(data: dict, key: str, value: Any) -> None:
     node = data
     for i, p in enumerate(parts[:-1]):
         nxt = node.get(p)
-        if nxt is None and p in ("crack",):
+        if nxt is None and (p in ("crack", "modifications", "measurement")
+                            or parts[0] == "modifications"):
             nxt = node[p] = {}
         if not isinstance(nxt, dict):
             raise InputError(".".join(parts[: i + 1]), nxt if nxt is not None else key,
@@ -388,6 +862,8 @@ def _set_dotted(data: dict, key: str, value: Any) -> None:
 
 def parse_overrides(items: Iterable[str]) -> dict[str, Any]:
     """Parse ``key=value`` strings; values are TOML values when they parse, else strings.
+
+    Values longer than :data:`MAX_OVERRIDE_CHARS` and control characters are refused.
 
     Examples
     --------
@@ -403,10 +879,22 @@ def parse_overrides(items: Iterable[str]) -> dict[str, Any]:
         key, raw = key.strip(), raw.strip()
         if not key:
             raise InputError("--set", item, "a non-empty dotted key before '='")
+        check_text(key, "--set")
+        if len(key) > 200:
+            raise InputError("--set", key, "a dotted key of at most 200 characters")
+        check_text(raw, key)
+        if len(raw) > MAX_OVERRIDE_CHARS:
+            raise InputError(key, raw, f"a value of at most {MAX_OVERRIDE_CHARS} characters")
         try:
             value = tomllib.loads(f"v = {raw}")["v"]
         except tomllib.TOMLDecodeError:
             value = raw
+        except (ValueError, RecursionError):
+            raise InputError(key, raw, "a number of at most 4300 digits and values nested at "
+                                       f"most {MAX_NESTING} deep") from None
+        if _tree_depth(value) > MAX_NESTING:
+            raise InputError(key, raw, f"a value nested at most {MAX_NESTING} deep")
+        _check_strings(value, key)
         out[key] = value
     return out
 
@@ -456,19 +944,92 @@ def _allowed_keys(parent: str) -> list[str]:
         if not sub:
             return []
         model = sub[0]
-    return sorted(model.model_fields)
+    keys = sorted(model.model_fields)
+    return [k for k in keys if k != "provenance"] + (["extends"] if model is Case else [])
 
 
-def _validate(data: dict[str, Any], source: str) -> Case:
+def _model_leaves(model: BaseModel, prefix: str = "") -> Iterator[tuple[str, Any]]:
+    for name in type(model).model_fields:
+        if name == "provenance":
+            continue
+        value = getattr(model, name)
+        key = f"{prefix}.{name}" if prefix else name
+        if isinstance(value, BaseModel):
+            yield from _model_leaves(value, key)
+        elif value is not None:
+            yield key, value
+
+
+def _validate(data: dict[str, Any], source: str = "") -> Case:
+    """Validate plain case data, naming the first bad field as the user wrote it."""
     try:
         return Case.model_validate(data)
     except ValidationError as exc:
         raise _format_validation_error(exc, data) from None
 
 
+@dataclass(frozen=True)
+class CaseDetails:
+    """A case with how each of its values was given (for ``geardyn config show``).
+
+    Attributes
+    ----------
+    case : Case
+    written : dict
+        Raw case data as written in the files and overrides (unit strings kept), nested.
+    origin : dict
+        Dotted key -> where the value was given: a case file, ``"--set"``, or ``"default"``.
+    """
+
+    case: Case
+    written: dict[str, Any]
+    origin: dict[str, str]
+
+
+def load_case_details(path: str | Path | None = None,
+                      overrides: Iterable[str] | Mapping[str, Any] = (), *,
+                      override_source: str = SET_SOURCE) -> CaseDetails:
+    """:func:`load_case` keeping the values as written and where each came from."""
+    layers = _shipped_layer(PAPER_CASE, ()) if path is None else _file_layer(Path(path), ())
+    data, prov, origin = layers.data, layers.prov, layers.origin
+    ov = dict(overrides) if isinstance(overrides, Mapping) else parse_overrides(overrides)
+    for key, value in ov.items():
+        if isinstance(overrides, Mapping):
+            check_text(key, "--set")
+            _check_strings(value, key)
+        _set_dotted(data, key, value)
+        if key in _UNSOURCED:
+            continue
+        _drop_under(prov, key)
+        _drop_under(origin, key)
+        prov[key] = override_source
+        origin[key] = override_source
+    changed = [k for k in ov if k not in _UNSOURCED]
+    if changed and "name" not in ov:  # no longer the named case: say so
+        data["name"] = f"{data.get('name', 'case')} (modified)"
+        if "description" not in ov:
+            keys = ", ".join(changed[:6]) + (", ..." if len(changed) > 6 else "")
+            data["description"] = f"{data.get('description', '')} [changed by {override_source}: " \
+                                  f"{keys}]".strip()
+    data["provenance"] = prov
+    case = _validate(data)
+    origin = {**{k: "default" for k, _ in _model_leaves(case) if k not in _UNSOURCED}, **origin}
+    written = {k: v for k, v in data.items() if k != "provenance"}
+    return CaseDetails(case=case, written=written, origin=origin)
+
+
 def load_case(path: str | Path | None = None, overrides: Iterable[str] | Mapping[str, Any] = (),
-              ) -> Case:
-    """Read and validate a case file.
+              *, override_source: str = SET_SOURCE) -> Case:
+    """Read and validate a case file, over its base case.
+
+    A case file may give only the values it changes: it extends a base case, the paper's
+    (``extends = "xue_howard"``, the default), another shipped case, or another case file
+    (``extends = "base.toml"``, relative to the extending file; cycles are refused); ``extends =
+    false`` marks a complete case. Tables merge key by key. Values from a base keep their source;
+    a value of the file without a ``source`` gets the file's path as its source; overrides get
+    ``override_source`` (``"--set"``). A file that extends another keeps its own ``name`` (default:
+    the file's stem) and ``description``; overrides rename the case ``"<name> (modified)"`` unless
+    they set ``name``.
 
     Parameters
     ----------
@@ -476,6 +1037,8 @@ def load_case(path: str | Path | None = None, overrides: Iterable[str] | Mapping
         A TOML case file. ``None`` loads the paper's case shipped with geardyn.
     overrides : iterable of str or mapping
         ``"dotted.key=value"`` strings (or a mapping) applied before validation.
+    override_source : str
+        Source recorded for the overridden values.
 
     Returns
     -------
@@ -484,32 +1047,12 @@ def load_case(path: str | Path | None = None, overrides: Iterable[str] | Mapping
     Raises
     ------
     DataFileError
-        If the file is missing, unreadable or not valid TOML.
+        If the file is missing, not a regular file, larger than :data:`MAX_CASE_BYTES`, not
+        UTF-8, not valid TOML or nested deeper than :data:`MAX_NESTING`.
     InputError
         If a value is invalid; the message names the dotted key, the value and what is allowed.
     """
-    if path is None:
-        text = resources.files("geardyn.cases").joinpath(f"{PAPER_CASE}.toml").read_text("utf-8")
-        origin = f"geardyn/cases/{PAPER_CASE}.toml"
-    else:
-        from .io import read_text
-
-        text = read_text(path, "case file")
-        origin = str(path)
-    try:
-        raw = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise DataFileError(origin, f"is not valid TOML: {exc}") from None
-    prov: dict[str, str] = {}
-    data = _extract_provenance(raw, "", prov)
-    if isinstance(data.get("provenance"), dict):
-        prov = {**data["provenance"], **prov}
-    ov = dict(overrides) if isinstance(overrides, Mapping) else parse_overrides(overrides)
-    for key, value in ov.items():
-        _set_dotted(data, key, value)
-        prov.pop(key, None)
-    data["provenance"] = prov
-    return _validate(data, source=origin)
+    return load_case_details(path, overrides, override_source=override_source).case
 
 
 def paper_case(overrides: Iterable[str] | Mapping[str, Any] = ()) -> Case:
@@ -518,15 +1061,44 @@ def paper_case(overrides: Iterable[str] | Mapping[str, Any] = ()) -> Case:
 
 
 # --------------------------------------------------------------------------- writing
-@functools.cache  # builds a JSON schema: slow, and the answer never changes
+def _dimension_in(annotation: Any, metadata: Iterable[Any] = ()) -> str | None:
+    """The dimension a quantity type declares (its ``x-dimension``), searching unions and lists."""
+    for m in list(metadata) + list(getattr(annotation, "__metadata__", ())):
+        js = getattr(m, "json_schema", None)
+        if isinstance(m, WithJsonSchema) and isinstance(js, dict) and "x-dimension" in js:
+            return js["x-dimension"]
+    for a in typing.get_args(annotation):
+        d = _dimension_in(a)
+        if d is not None:
+            return d
+    return None
+
+
+@functools.cache
 def _dimension_of(model: type[BaseModel], name: str) -> str | None:
-    """The physical dimension of a quantity field (from its JSON-schema unit), else None."""
-    schema = model.model_json_schema()["properties"].get(name, {})
-    unit = schema.get("x-unit") or next((a.get("x-unit") for a in schema.get("anyOf", [])
-                                         if isinstance(a, dict) and a.get("x-unit")), None)
-    if unit is None:
+    """The physical dimension of a quantity field (a key of :data:`DIMENSIONS`), else None."""
+    f = model.model_fields.get(name)
+    if f is None:
         return None
-    return next(key for key, dim in DIMENSIONS.items() if dim.si_unit == unit)
+    return _dimension_in(f.annotation, f.metadata)
+
+
+def _field_dimension(key: str) -> str | None:
+    """Dimension of a dotted case key (``"pair.module"`` -> ``"length"``), else None."""
+    model: type[BaseModel] = Case
+    parts = key.split(".")
+    for p in parts[:-1]:
+        f = model.model_fields.get(p)
+        if f is None:
+            return None
+        sub = [a for a in getattr(f.annotation, "__args__", (f.annotation,))
+               if isinstance(a, type) and issubclass(a, BaseModel)]
+        if not sub:
+            return None
+        model = sub[0]
+    if parts[-1] not in model.model_fields:
+        return None
+    return _dimension_of(model, parts[-1])
 
 
 def _to_toml_tree(model: BaseModel, prov: Mapping[str, str], prefix: str = "") -> dict:
@@ -544,53 +1116,64 @@ def _to_toml_tree(model: BaseModel, prov: Mapping[str, str], prefix: str = "") -
         dim = _dimension_of(type(model), name)
         if dim is not None and isinstance(value, float):
             value = format_si(value, dim)
-        if key in prov:
+        if key in prov and key not in _UNSOURCED:
             value = {"value": value, "source": prov[key]}
         out[name] = value
     return out
 
 
-def _toml_scalar(v: Any) -> str:
-    if isinstance(v, bool):
-        return "true" if v else "false"
-    if isinstance(v, int):
-        return str(v)
-    if isinstance(v, float):
-        return repr(v) if math.isfinite(v) else ("nan" if math.isnan(v) else
-                                                 ("inf" if v > 0 else "-inf"))
-    if isinstance(v, str):
-        return json.dumps(v, ensure_ascii=False)  # a JSON string is a TOML basic string
-    if isinstance(v, list | tuple):
-        return "[" + ", ".join(_toml_scalar(x) for x in v) + "]"
-    if isinstance(v, dict):
-        return "{ " + ", ".join(f"{k} = {_toml_scalar(x)}" for k, x in v.items()) + " }"
-    raise TypeError(f"cannot write {type(v).__name__} to TOML")
+def _dumps(tree: Mapping[str, Any]) -> str:
+    import tomli_w
+
+    # name, description and extends first, then the sections (tomli-w keeps the order given)
+    head = {k: tree[k] for k in ("name", "description", "extends") if k in tree}
+    return tomli_w.dumps({**head, **{k: v for k, v in tree.items() if k not in head}})
 
 
 def case_to_toml(case: Case) -> str:
-    """The effective case as TOML text, quantities as SI unit strings, sources kept inline.
+    """The effective case as TOML text (written by tomli-w), quantities as SI unit strings.
 
-    A value with a recorded source is written ``key = { value = ..., source = "..." }``. The text
+    A value with a recorded source is written as a ``{ value = ..., source = "..." }`` table (a
+    ``[section.key]`` table in the text). The text says ``extends = false`` (a complete case) and
     loads back to an equal case with :func:`load_case`.
     """
     tree = _to_toml_tree(case, case.provenance)
-    lines: list[str] = []
+    tree["extends"] = False
+    return _dumps(tree)
 
-    def is_section(v: Any) -> bool:
-        return isinstance(v, dict) and not ("value" in v and set(v) <= {"value", "source"})
 
-    def emit(node: dict, path: str) -> None:
-        scalars = [(k, v) for k, v in node.items() if not is_section(v)]
-        if path and (scalars or not any(is_section(v) for v in node.values())):
-            lines.append(f"\n[{path}]")
-        for k, v in scalars:
-            lines.append(f"{k} = {_toml_scalar(v)}")
-        for k, v in node.items():
-            if is_section(v):
-                emit(v, f"{path}.{k}" if path else k)
+def case_to_display_toml(details: CaseDetails) -> str:
+    """The case as ``geardyn config show`` prints it: TOML (loadable by :func:`load_case`) with
+    each value as written (``"20 deg"``), its SI value beside when it differs (``si``, stating
+    the 2 pi of Hz), its ``source`` and its ``origin`` (base case file, case file, ``"--set"``
+    or ``"default"``)."""
+    from .units import hz_note
 
-    emit(tree, "")
-    return "\n".join(lines).lstrip("\n") + "\n"
+    case, origin = details.case, details.origin
+    tree: dict[str, Any] = {"name": case.name, "description": case.description,
+                            "extends": False}
+    for key, value in _model_leaves(case):
+        if key in _UNSOURCED:
+            continue
+        written = _raw_value(details.written, tuple(key.split(".")), None)
+        dim = _field_dimension(key)
+        shown: Any = value
+        entry: dict[str, Any] = {}
+        if dim is not None and isinstance(value, float):
+            si = format_si(value, dim)
+            shown = written if isinstance(written, str) else si
+            if isinstance(written, str) and written.strip() != si:
+                note = hz_note(written) if dim == "angular velocity" else None
+                entry["si"] = f"{float(value):.10g} {DIMENSIONS[dim].si_unit}" + \
+                    (f" ({note})" if note else "")
+        entry = {"value": shown, **entry, "source": case.provenance.get(key, DEFAULT_SOURCE),
+                 "origin": origin.get(key, "default")}
+        node = tree
+        parts = key.split(".")
+        for p in parts[:-1]:
+            node = node.setdefault(p, {})
+        node[parts[-1]] = entry
+    return _dumps(tree)
 
 
 def case_schema() -> str:

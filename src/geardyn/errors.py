@@ -7,7 +7,40 @@ clear line and exit with status 2 instead of showing a traceback.
 
 from __future__ import annotations
 
+import re
 from typing import Any
+
+#: Longest rendering of a value, a field name and an "allowed" text in a message [characters]:
+#: a 16 MB input is never echoed whole, and a message stays one line under ~500 characters.
+MAX_VALUE_CHARS = 100
+MAX_FIELD_CHARS = 100
+MAX_ALLOWED_CHARS = 300
+
+_CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f]+")
+
+
+def _clip(text: str, limit: int) -> str:
+    """One line of at most ``limit`` characters (control characters shown as one space)."""
+    text = _CONTROL.sub(" ", text)
+    return text if len(text) <= limit else text[: limit - 1] + "…"
+
+
+def short_repr(value: Any, limit: int = MAX_VALUE_CHARS) -> str:
+    """``repr(value)`` cut to ``limit`` characters with an ellipsis and the full length.
+
+    Safe for huge inputs: a long string is cut before ``repr``; an integer too long for
+    ``repr`` (Python's 4300-digit limit) is described by its size.
+    """
+    if isinstance(value, str | bytes) and len(value) > limit:
+        return repr(value[: limit // 2]) + f"… ({len(value)} characters)"
+    try:
+        text = repr(value)
+    except ValueError:  # int too long to convert
+        return f"<integer of about {int(value.bit_length() * 0.30103) + 1} digits>"
+    if len(text) > limit:
+        return text[: limit - 1] + f"… ({len(text)} characters)"
+    return text
+
 
 __all__ = [
     "GeardynError",
@@ -15,6 +48,7 @@ __all__ = [
     "GeometryError",
     "NumericalError",
     "DataFileError",
+    "short_repr",
 ]
 
 
@@ -39,7 +73,8 @@ class InputError(GeardynError, ValueError):
         self.field = field
         self.value = value
         self.allowed = allowed
-        super().__init__(f"{field}: got {value!r}; allowed: {allowed}")
+        super().__init__(f"{_clip(str(field), MAX_FIELD_CHARS)}: got {short_repr(value)}; "
+                         f"allowed: {_clip(str(allowed), MAX_ALLOWED_CHARS)}")
 
 
 class GeometryError(InputError):
@@ -79,4 +114,4 @@ class DataFileError(GeardynError, OSError):
     def __init__(self, path: Any, problem: str):
         self.path = str(path)
         self.problem = problem
-        super().__init__(f"{self.path}: {problem}")
+        super().__init__(f"{_clip(self.path, MAX_FIELD_CHARS)}: {_clip(str(problem), MAX_ALLOWED_CHARS)}")

@@ -11,9 +11,9 @@ import pytest
 GEARDYN = [sys.executable, "-m", "geardyn"]
 
 
-def run(*args, cwd=None):
+def run(*args, cwd=None, timeout=120):
     return subprocess.run(GEARDYN + list(args), capture_output=True, text=True, cwd=cwd,
-                          timeout=120)
+                          timeout=timeout)
 
 
 def test_help_lists_commands():
@@ -62,7 +62,9 @@ def test_config_show_round_trips(tmp_path):
     p.write_text(r.stdout)
     v = run("config", "validate", str(p))
     assert v.returncode == 0 and "valid" in v.stdout
-    assert "teeth = 25" in r.stdout and 'source = "paper Table 1"' in r.stdout
+    # the override is marked with its origin (issue 13; it used to lose its provenance)
+    assert "[pinion.teeth]\nvalue = 25\nsource = \"--set\"" in r.stdout
+    assert 'source = "paper Table 1"' in r.stdout
 
 
 def test_config_schema():
@@ -70,10 +72,12 @@ def test_config_schema():
     assert r.returncode == 0 and json.loads(r.stdout)["title"] == "Case"
 
 
+@pytest.mark.slow
 def test_run_writes_the_geometry_stage(tmp_path):
     out = tmp_path / "out"
     r = run("run", "--out", str(out), "--quick", "--stiffness", "pem", "--set",
-            "simulation.record_time=0.1 s", "--set", "diagnostics.samples_per_rev=512")
+            "simulation.record_time=0.1 s", "--set", "diagnostics.samples_per_rev=512",
+            timeout=900)
     assert r.returncode == 0, r.stderr
     s = json.loads((out / "summary.json").read_text())
     assert s["centre_distance_change_mm"] == pytest.approx(1.0852, abs=1e-4)

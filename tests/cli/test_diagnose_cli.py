@@ -19,6 +19,7 @@ def _write_csv(path):
                comments="")
 
 
+@pytest.mark.slow
 def test_diagnose_measured_csv(tmp_path):
     csv = tmp_path / "m.csv"
     _write_csv(csv)

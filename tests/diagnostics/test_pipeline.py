@@ -12,6 +12,7 @@ import xarray as xr
 
 from geardyn.diagnostics import (
     SIMULATION_SIGNALS,
+    DiagnosticsWarning,
     diagnose,
     diagnose_file,
     load_measurement,
@@ -158,7 +159,8 @@ def test_csv_with_header_angle_and_tach(tmp_path, measured):
     assert np.max(np.abs(res.signals["accel"].tsa.average - _expected_tsa())) < 2e-6
     # sampled tachometer pulse train: angle from the rising edges (the phasor is 0.3 rad wide,
     # the rising edge is at angle 0 of each revolution)
-    m2 = load_measurement(path, signal=1, time="time", tach="tach")
+    with pytest.warns(DiagnosticsWarning, match="not resolved by the sampling"):
+        m2 = load_measurement(path, signal=1, time="time", tach="tach")
     # the record starts inside a pulse: rising edges at revolutions 1..5 only
     assert m2.tach_times.size == 5
     np.testing.assert_allclose(m2.tach_times, [t[np.searchsorted(theta, 2 * np.pi * k)]
@@ -211,12 +213,22 @@ def test_mat_v73_hdf5(tmp_path, measured):
     with h5py.File(path, "w", userblock_size=512) as f:
         f["vib"] = v[None, :]  # MATLAB writes column vectors as 1 x n (column-major)
         f["ang"] = theta[None, :]
+        for name in ("vib", "ang"):  # every MATLAB variable carries its class
+            f[name].attrs["MATLAB_class"] = np.bytes_("double")
     header = b"MATLAB 7.3 MAT-file, Platform: GLNXA64, Created on: test HDF5 schema 1.00 ."
     with open(path, "r+b") as fh:
         fh.write(header.ljust(116, b" ") + b"\x00" * 8 + b"\x00\x02" + b"IM")
     table = read_table(path)
     assert set(table.names) == {"vib", "ang"}
     np.testing.assert_array_equal(table.columns["vib"], v)
+    # an HDF5 file whose datasets carry no MATLAB class holds no MATLAB variables: a clear
+    # error that says why (not the reader's log lines on stderr)
+    with h5py.File(tmp_path / "plain.mat", "w", userblock_size=512) as f:
+        f["vib"] = v[None, :]
+    with open(tmp_path / "plain.mat", "r+b") as fh:
+        fh.write(header.ljust(116, b" ") + b"\x00" * 8 + b"\x00\x02" + b"IM")
+    with pytest.raises(DataFileError, match="not a MATLAB datatype"):
+        read_table(tmp_path / "plain.mat")
 
 
 @pytest.mark.parametrize(

@@ -167,7 +167,7 @@ def test_numba_kernel_matches_numpy_twin():
     for acc, size in ((True, 97), (False, 3000)):
         a = np.zeros((2, size if acc else 3000))
         b = np.zeros_like(a)
-        kernel(angle, x, 0.31, 0.0123, 3000, 97, acc, a)
+        kernel(angle, x, 0.31, 0.0123, 3000, 97, acc, a, 6)
         _resample_numpy(angle, x, 0.31, 0.0123, 3000, 97, acc, b, chunk=700)
         np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-12)
 
@@ -199,8 +199,9 @@ def test_multichannel_records_and_angle_origin():
     assert res.records.shape == (2, res.n_averages, 128)
     assert res.start_angle == pytest.approx(TWO_PI)
     np.testing.assert_allclose(res.records.mean(axis=1), res.average, atol=1e-14)
-    # aligned to the absolute angle: the TSA is the signal at theta = 2 pi n / N, to the
-    # 4-point Lagrange bound (q h)^4 * 9/16 / 4! = 3.6e-7 at q = 3, h = 2 pi / 300
+    # aligned to the absolute angle: the TSA is the signal at theta = 2 pi n / N, within the
+    # 4-point Lagrange bound (q h)^4 * 9/16 / 4! = 3.6e-7 at q = 3, h = 2 pi / 300 (the
+    # default 6-point interpolant is tighter still)
     np.testing.assert_allclose(res.average[0], np.cos(3 * res.angle - 0.7), atol=1e-6)
     single = tsa(x[1], angle=theta, samples_per_rev=128)
     np.testing.assert_allclose(single.average, res.average[1], atol=1e-14)
@@ -228,9 +229,9 @@ def test_any_samples_per_rev(nper):
     res = tsa(x, angle=theta, samples_per_rev=nper)
     assert res.average.shape == (nper,) and res.n_averages == 4
     # order 300 is above N/2 for both N: removed by the anti-alias filter, not aliased;
-    # what is left is the cubic interpolation error of orders 100 and 300 at 4000 raw
-    # samples per revolution (measured 4.4e-5 and 6.7e-6: images of order 300 through the
-    # interpolant that land below N/2 dominate for N = 333)
+    # what is left is the interpolation error of orders 100 and 300 at 4000 raw samples per
+    # revolution (measured 4.4e-5 and 6.7e-6 with the 4-point interpolant: images of order 300
+    # through the interpolant that land below N/2 dominate for N = 333)
     truth = np.cos(5 * res.angle) + 0.5 * np.sin(100 * res.angle)
     np.testing.assert_allclose(res.average, truth, atol=1e-4)
     plain = tsa(x, angle=theta, samples_per_rev=nper, antialias=False)
@@ -259,9 +260,11 @@ def test_tach_min_interval_discards_chatter():
     s[100:110] = 1
     s[111:115] = 1  # chatter 1 ms after the first edge
     s[600:610] = 1
-    edges = tach_pulse_times(s, fs=fs, threshold=0.5)
+    with pytest.warns(DiagnosticsWarning, match="not resolved by the sampling"):
+        edges = tach_pulse_times(s, fs=fs, threshold=0.5)
     assert edges.size == 3
-    kept = tach_pulse_times(s, fs=fs, threshold=0.5, min_interval=0.1)
+    with pytest.warns(DiagnosticsWarning, match="not resolved by the sampling"):
+        kept = tach_pulse_times(s, fs=fs, threshold=0.5, min_interval=0.1)
     np.testing.assert_allclose(kept, [0.0995, 0.5995])
 
 

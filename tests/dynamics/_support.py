@@ -13,7 +13,7 @@ from geardyn.dynamics import DynamicModel, make_setup
 from geardyn.stiffness import StiffnessMap
 from geardyn.stiffness.map import lookup
 
-K_PAIR = 8e7  # N/m, one tooth pair of the paper's aluminium gears (design/dynamics.md)
+K_PAIR = 8e7  # N/m, one tooth pair of the paper's aluminium gears (docs/verification/dynamics.md)
 
 
 def short_case(**over):

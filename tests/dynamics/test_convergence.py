@@ -1,5 +1,5 @@
 """The full 6-DOF model against scipy's DOP853 (an independent right-hand side of eqs. 9-16),
-observed orders under dt halving, and the energy audit (design/dynamics.md protocol 4 and 5)."""
+observed orders under dt halving, and the energy audit (docs/verification/dynamics.md, integration checks)."""
 
 from __future__ import annotations
 

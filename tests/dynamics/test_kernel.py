@@ -75,7 +75,7 @@ def test_kernel_matches_twin_through_tooth_separation():
 
 def test_undamped_sdof_period_error_and_no_decay():
     """Average acceleration: no amplitude decay; numerical frequency (2/dt) atan(w dt/2), i.e.
-    period error (w dt)^2/12 to leading order (design/dynamics.md, protocol 2)."""
+    period error (w dt)^2/12 to leading order (docs/verification/dynamics.md, integration checks)."""
     m, k = 1.5, 6e3
     w = math.sqrt(k / m)
     for wdt in (0.1, 0.3):
@@ -128,8 +128,8 @@ def test_damped_sdof_against_closed_form_second_order():
 @pytest.mark.parametrize("k2_over_k1, stable", [(1.6, True), (3.2, False)])
 def test_square_wave_parametric_oscillator(k2_over_k1, stable):
     """Square-wave k(t) (k1 for 40 % of the period, k2 for 60 %) against the exact product of
-    per-segment transfer matrices (design/dynamics.md protocol 3), in a stable and an unstable
-    Floquet case.
+    per-segment transfer matrices (docs/verification/dynamics.md, integration checks), in a stable
+    and an unstable Floquet case.
 
     The switches sit a quarter step past a grid point, so every switch commits the same local
     error: the steps cap the scheme at first order, observed 1.0 +/- 0.1. The unstable case grows

@@ -84,7 +84,7 @@ def test_asymmetric_torsional_damping_uses_q_stg():
 
 
 def test_damping_from_ratios(dyn, case):
-    """Bearings: q = 2 zeta sqrt(k m) (about 84 N s/m, design/dynamics.md); couplings: the
+    """Bearings: q = 2 zeta sqrt(k m) (about 84 N s/m, docs/verification/dynamics.md); couplings: the
     two-inertia mode has damping ratio 0.05 (complex eigenvalues); mesh: 2 zeta sqrt(k m_e)."""
     assert dyn.damping["q_yp"] == pytest.approx(2 * 0.05 * math.sqrt(1e6 * 0.7), rel=1e-14)
     assert round(dyn.damping["q_yp"]) == 84
@@ -176,7 +176,7 @@ def test_kernel_law_torque_matches_numpy_laws():
 
 
 def test_static_equilibrium_paper_numbers(dyn, smap):
-    """design/dynamics.md: N = T/r_b = 1542.3 N, y_g - y_p = 3.085 mm, eq. 4 gives 1.0852 mm;
+    """docs/verification/dynamics.md: N = T/r_b = 1542.3 N, y_g - y_p = 3.085 mm, eq. 4 gives 1.0852 mm;
     the static state satisfies the equations of motion in deviation form."""
     st = static_equilibrium(dyn, smap, which="II")
     assert round(st.mesh_force, 1) == 1542.3
@@ -206,7 +206,7 @@ def test_static_equilibrium_refuses_a_map_without_the_operating_point(dyn, case)
 
 def test_natural_frequencies(dyn):
     """Without the mesh the bearing modes are sqrt(k_y/m)/(2 pi) = 190.2 Hz; a rigid-body mode
-    is always 0; the highest mode for the largest stiffness is 4-6.5 kHz (design/dynamics.md)."""
+    is always 0; the highest mode for the largest stiffness is 4-6.5 kHz (docs/verification/dynamics.md)."""
     f0 = natural_frequencies(dyn, 0.0)
     assert f0[0] < 1e-3 and f0[1] < 1e-3   # rigid body and the free torsional pinion/gear pair
     np.testing.assert_allclose(f0[2:4], math.sqrt(1e6 / 0.7) / (2 * math.pi), rtol=1e-12)
@@ -234,7 +234,7 @@ def test_operating_arrays_match_gear_pair(case):
         assert op["pressure_angle"][i] == pytest.approx(ref.pressure_angle, rel=1e-14)
         assert op["contact_ratio"][i] == pytest.approx(ref.contact_ratio, rel=1e-12)
         assert op["contact_ratio_eq8"][i] == pytest.approx(ref.contact_ratio_eq8, rel=1e-12)
-    # design/dynamics.md checked numbers at +1.07 mm
+    # docs/verification/dynamics.md static point at +1.07 mm
     i = 4
     assert math.degrees(op["pressure_angle"][i]) == pytest.approx(21.178, abs=5e-4)
     assert op["contact_ratio"][i] == pytest.approx(1.4198, abs=1e-4)

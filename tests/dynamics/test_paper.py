@@ -1,81 +1,58 @@
-"""Validation against the paper (Xue & Howard 2018) with the analytical (PEM) stiffness map:
-torque balance, Fig. 8 levels, Fig. 9 iteration pattern, Table 2 magnitudes.
+"""Comparisons with the paper (Xue & Howard 2018) that depend on the mesh stiffness and the
+dynamics, with the PEM stiffness map: Fig. 9 iteration pattern, Table 2 magnitudes, handovers.
+The consistency checks (static balance, calibrated inputs) are in test_paper_consistency.py.
 
-Tolerances are those the source supports: the checked numbers of design/dynamics.md tightly,
-the paper's rounded figure values to their last digit, Table 2 within a factor of 2 (the paper
-leaves the damping, inertias and couplings unspecified)."""
+Tolerances: Table 2 is compared in log-ratio, symmetric, within the report's factor 2 for every
+standard deviation (geardyn.studies.paper_validation.STD_FACTOR, fixed before comparing: the
+paper gives no uncertainty, and the damping, inertias and couplings it leaves unspecified scale
+the response). Measured: transmission error 1.15 (model I) and 1.07 (model II), the other signals
+1.2-1.9. Halving the mesh stiffness must fail the comparison (measured 2.4 and 2.3:
+test_halved_mesh_stiffness_keeps_the_checks_and_fails_the_comparison)."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
-import warnings
 
 import numpy as np
 import pytest
 
 import geardyn
 from geardyn.dynamics import simulate, summary
-from geardyn.stiffness import centre_distance_grid
+from geardyn.studies.paper_validation import STD_FACTOR
 
-T_REV = 2 * math.pi / 114.14          # one pinion revolution at the paper's speed [s]
 CRACKED_TOOTH = 11                    # the case file's cracked pinion tooth
 
-
-@pytest.fixture(scope="module")
-def case():
-    return geardyn.paper_case({"simulation.settle_time": 0.2, "simulation.record_time": T_REV})
-
-
-@pytest.fixture(scope="module")
-def pem(case):
-    from geardyn.stiffness.pem import pem_map
-
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")   # the Sainsot range note of the paper's teeth
-        return pem_map(case, centre_distance_grid(case), cracked=True)
+#: Table 2 of the paper: standard deviations of model I and model II.
+TABLE2 = {"v_yg": (0.0100, 0.0127), "omega_p": (0.1389, 0.1815),
+          "transmission_error": (2.6e-5, 3.2e-5)}
+#: Allowed factor (symmetric in log-ratio) of each Table 2 comparison, see the module docstring.
+TABLE2_FACTOR = {"v_yg": STD_FACTOR, "omega_p": STD_FACTOR, "transmission_error": STD_FACTOR}
 
 
 @pytest.fixture(scope="module")
-def runs(case, pem):
-    return {w: simulate(case, pem, model=w) for w in ("I", "II")}
+def runs(paper_runs):
+    return paper_runs
 
 
-@pytest.mark.parametrize("which", ["I", "II"])
-def test_torque_balance_and_static_levels(runs, which):
-    """Zero absolute torsional damping: over one revolution of the steady state the mean mesh
-    force is T/r_b = 1542.3 N, the mean centre distance change 1.0852 mm (eq. 4), and the mean
-    speed equals the load law's target 114.14 rad/s to 1e-4 (pinion and load)."""
-    ds = runs[which]
-    s = summary(ds)
-    assert round(s["mean_mesh_force_N"], 1) == 1542.3
-    r_b = 0.5 * 23 * 6e-3 * math.cos(math.radians(20))
-    assert s["mean_mesh_force_N"] == pytest.approx(100 / r_b, rel=1e-4)
-    assert round(s["mean_centre_distance_change_m"] * 1e3, 4) == 1.0852
-    assert s["mean_pinion_speed_rad_s"] == pytest.approx(114.14, rel=1e-4)
-    assert float(ds.omega_out.mean()) == pytest.approx(114.14, rel=1e-4)
-    assert int(ds.contact.min()) == 1            # no tooth separation at 100 N m
-    assert ds.attrs["complete"] == 1
+@pytest.fixture(scope="module")
+def case(paper_run_case):
+    return paper_run_case
 
 
-def test_model_ii_matches_fig8_levels(runs):
-    """Fig. 8: centre distance change about 1.07 mm (1.0852 with q_st = 0), pressure angle about
-    21.18 deg, contact ratio 1.43 by eq. 8 and 1.42 physical."""
-    s = summary(runs["II"])
-    assert s["mean_centre_distance_change_m"] == pytest.approx(1.07e-3, rel=0.02)
-    assert s["mean_pressure_angle_deg"] == pytest.approx(21.18, abs=0.02)
-    assert round(s["mean_contact_ratio_eq8"], 2) == 1.43
-    assert round(s["mean_contact_ratio"], 2) == 1.42
-    # the crack moves the centre distance, which returns to its level (Fig. 8a)
-    dd = runs["II"].centre_distance_change.values
-    assert 0.5e-6 < np.ptp(dd) < 20e-6
+@pytest.fixture(scope="module")
+def pem(paper_pem):
+    return paper_pem
 
 
-def test_absolute_damping_reproduces_the_papers_1_07_mm(case, pem):
-    """design/dynamics.md: q_st = 0.012 N m s/rad gives the paper's 1.07 mm."""
-    c = case.with_overrides({"pinion.torsional_damping": 0.012, "gear.torsional_damping": 0.012,
-                             "simulation.settle_time": 0.05})
-    s = summary(simulate(c, pem, model="II"))
-    assert round(s["mean_centre_distance_change_m"] * 1e3, 2) == 1.07
+def table2_comparison(runs) -> dict[tuple[str, str], tuple[float, bool]]:
+    """(signal, model) -> (ratio geardyn/paper, within the allowed factor)."""
+    out = {}
+    for name, paper in TABLE2.items():
+        for w, p in zip(("I", "II"), paper, strict=True):
+            r = float(runs[w][name].std()) / p
+            out[(name, w)] = (r, abs(math.log(r)) < math.log(TABLE2_FACTOR[name]))
+    return out
 
 
 def _handover_distance_steps(ds, pem):
@@ -134,16 +111,30 @@ def test_paper_flow_chart_iterates_where_the_centre_distance_moves(case, pem):
 
 
 def test_table2_magnitudes(runs):
-    """Table 2 within a factor of 2, and model II larger than model I in all three signals;
-    mean TE about 0.05 rad (0.048 from 2N/k_y + N/k_mesh)."""
-    paper = {"v_yg": (0.0100, 0.0127), "omega_p": (0.1389, 0.1815),
-             "transmission_error": (2.6e-5, 3.2e-5)}
-    for name, (p1, p2) in paper.items():
-        s1, s2 = (float(runs[w][name].std()) for w in ("I", "II"))
-        assert 0.5 < s1 / p1 < 2 and 0.5 < s2 / p2 < 2, (name, s1, s2)
-        assert s2 > s1
+    """Every Table 2 row within its factor (module docstring), and model II larger than model I
+    in all three signals, as in the paper."""
+    rows = table2_comparison(runs)
+    assert all(ok for _, ok in rows.values()), rows
+    for name in TABLE2:
+        assert rows[(name, "II")][0] * TABLE2[name][1] > rows[(name, "I")][0] * TABLE2[name][0]
+
+
+def test_halved_mesh_stiffness_keeps_the_checks_and_fails_the_comparison(case, pem, runs):
+    """With the mesh stiffness halved, the consistency checks still pass (they are fixed by the
+    static balance and the calibrated load: mean force 1542.3 N, 1.0852 mm, 114.14 rad/s) while
+    the transmission error of Table 2 leaves its factor in both models (measured 2.4 and 2.3)."""
+    half = dataclasses.replace(pem, k_mb=0.5 * pem.k_mb)
+    soft = {w: simulate(case, half, model=w) for w in ("I", "II")}
     for w in ("I", "II"):
-        assert float(runs[w].transmission_error.mean()) == pytest.approx(0.048, abs=0.001)
+        s = summary(soft[w])
+        assert round(s["mean_mesh_force_N"], 1) == 1542.3
+        assert round(s["mean_centre_distance_change_m"] * 1e3, 4) == 1.0852
+        assert s["mean_pinion_speed_rad_s"] == pytest.approx(114.14, rel=1e-4)
+    rows = table2_comparison(soft)
+    assert not rows[("transmission_error", "I")][1] and not rows[("transmission_error", "II")][1]
+    assert rows[("transmission_error", "I")][0] > 2.0
+    # the stiffer map passes (test_table2_magnitudes): the comparison separates the two
+    assert table2_comparison(runs)[("transmission_error", "I")][1]
 
 
 def test_handover_inside_a_step_has_no_fixed_point_and_is_accepted(pem):

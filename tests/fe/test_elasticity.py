@@ -136,3 +136,35 @@ def test_annulus_torsion(plane):
     g = E / (2 * (1 + NU))
     exact = torque / (4 * math.pi * g) * (1 / ri ** 2 - 1 / ro ** 2)
     assert rot == pytest.approx(exact, rel=5e-3)
+
+
+def test_fixed_dof_bookkeeping_by_scikit_fem_equals_the_hand_made_one():
+    """``ElasticBody`` takes the bore DOFs from ``basis.get_dofs(facets=...)`` and the free-free
+    stiffness from ``skfem.condense`` (issue 17.7). Both equal the former hand bookkeeping
+    (vertex DOFs of the bore nodes + midside DOFs of the bore facets; ``K[free][:, free]``)
+    exactly, so the solution is bit for bit the same (tolerance 0)."""
+    from scipy.sparse.linalg import splu
+
+    p, t, bore, outer = _annulus(0.02, 0.0615, 6, 60)
+    settings = MeshSettings(flank_size=1e-3, tooth_size=1e-3, body_size=1e-3)
+    bm = BodyMesh(p=p, t=t, edges={"bore": bore}, offsets=(), gear=None, crack=None,
+                  crack_mouth=None, crack_tip=None, settings=settings)
+    body = ElasticBody(bm, ElasticMaterial(E, NU, "strain"))
+    hand = np.unique(np.concatenate([body.basis.nodal_dofs[:, np.unique(bore)].ravel(),
+                                     body.basis.facet_dofs[:, body.facet_index(bore)].ravel()]))
+    np.testing.assert_array_equal(body.fixed, hand)
+    # 2 components x (60 bore vertices + 60 bore midsides)
+    assert body.fixed.size == 2 * 2 * 60
+    mask = np.ones(body.n_dofs, bool)
+    mask[hand] = False
+    free = np.nonzero(mask)[0]
+    np.testing.assert_array_equal(body.free, free)
+    kff_hand = body.K[free][:, free].tocsc()
+    kff = condense(body.K, D=body.fixed, expand=False).tocsc()
+    assert (kff != kff_hand).nnz == 0
+    rng = np.random.default_rng(2)
+    rhs = rng.standard_normal(body.n_dofs)
+    lu = splu(kff_hand, permc_spec="MMD_AT_PLUS_A", options={"SymmetricMode": True})
+    expected = np.zeros(body.n_dofs)
+    expected[free] = lu.solve(rhs[free])
+    np.testing.assert_array_equal(body.solve(rhs), expected)

@@ -135,3 +135,51 @@ def test_nothing_in_a_case_or_data_file_is_executed(tmp_path):
              "--teeth", "23", "--out", str(tmp_path / "o"))
     assert r.returncode == 2 and "Traceback" not in r.stderr
     assert not marker.exists()
+
+
+def test_cache_folder_honours_geardyn_cache_dir_then_xdg(tmp_path, monkeypatch):
+    """GEARDYN_CACHE_DIR first; else the platform's user cache folder (platformdirs), which on
+    Linux is $XDG_CACHE_HOME/geardyn, by default ~/.cache/geardyn."""
+    import platformdirs
+
+    from geardyn.cache import cache_dir
+
+    monkeypatch.setenv("GEARDYN_CACHE_DIR", str(tmp_path / "mine"))
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "xdg"))
+    assert cache_dir() == tmp_path / "mine"
+    monkeypatch.delenv("GEARDYN_CACHE_DIR")
+    expected = platformdirs.user_cache_path("geardyn", appauthor=False)
+    assert cache_dir() == expected
+    if sys.platform.startswith("linux"):
+        assert cache_dir() == tmp_path / "xdg" / "geardyn"
+        monkeypatch.delenv("XDG_CACHE_HOME")
+        monkeypatch.setenv("HOME", str(tmp_path / "home"))
+        assert cache_dir() == tmp_path / "home" / ".cache" / "geardyn"
+
+
+def test_entry_lock_excludes_a_second_holder_in_the_same_process(tmp_path):
+    """The entry lock (filelock) is a real lock between threads too: the second holder gets it
+    only after the first released it."""
+    import threading
+
+    from geardyn.cache import _entry_lock
+
+    entry = tmp_path / "k" / "e.nc"
+    events: list[str] = []
+    held, trying = threading.Event(), threading.Event()
+
+    def second():
+        trying.set()
+        with _entry_lock(entry):
+            events.append("second acquired")
+
+    with _entry_lock(entry):
+        t = threading.Thread(target=second)
+        t.start()
+        trying.wait(10)
+        t.join(0.3)  # the second thread is blocked on the lock meanwhile
+        assert t.is_alive()
+        events.append("first released")
+        held.set()
+    t.join(10)
+    assert events == ["first released", "second acquired"]

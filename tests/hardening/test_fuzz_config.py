@@ -8,6 +8,7 @@ is reported in the session summary.
 from __future__ import annotations
 
 import json
+import os
 
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -18,6 +19,10 @@ from geardyn.cli import app
 from geardyn.config import Case, case_to_toml, paper_case
 
 runner = CliRunner()
+
+#: Examples per test: 300 in the everyday suite and CI, any number with ``GEARDYN_FUZZ_EXAMPLES``
+#: (1000 for a thorough run before a release).
+FUZZ_EXAMPLES = int(os.environ.get("GEARDYN_FUZZ_EXAMPLES", "300"))
 
 
 def _leaf_keys() -> list[str]:
@@ -62,7 +67,7 @@ def check(result) -> None:
         assert result.exception is None or isinstance(result.exception, SystemExit)
 
 
-@settings(max_examples=1000, deadline=None, suppress_health_check=list(HealthCheck))
+@settings(max_examples=FUZZ_EXAMPLES, deadline=None, suppress_health_check=list(HealthCheck))
 @given(key=keys, value=values)
 def test_geometry_with_fuzzed_overrides(key, value, fuzz_counter):
     fuzz_counter["geometry --set"] += 1
@@ -77,7 +82,7 @@ def base_text() -> str:
     return case_to_toml(paper_case())
 
 
-@settings(max_examples=1000, deadline=None, suppress_health_check=list(HealthCheck))
+@settings(max_examples=FUZZ_EXAMPLES, deadline=None, suppress_health_check=list(HealthCheck))
 @given(data=st.data())
 def test_config_validate_with_fuzzed_files(data, base_text, tmp_path_factory, fuzz_counter):
     """Mutated case files: deleted lines, replaced values, truncation, garbage bytes."""

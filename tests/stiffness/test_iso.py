@@ -1,4 +1,4 @@
-"""ISO 6336-1 single and mesh stiffness against the worked values of design/stiffness.md 4.3."""
+"""ISO 6336-1 single and mesh stiffness against the worked values of docs/verification/stiffness.md 4.3."""
 
 from __future__ import annotations
 
@@ -39,7 +39,7 @@ def test_seed_pair_from_geometry():
     assert s.contact_ratio == pytest.approx(1.5916, abs=1e-4)
     assert s.c_mesh / N_MM_UM == pytest.approx(17.27, abs=0.006)
     # at the paper's operating centre distance (eps = 1.4308 with eq. 8's value):
-    # 11.962 (0.75 * 1.4308 + 0.25) = 15.83 (design/stiffness.md 4.3 prints 14.82, a slip)
+    # 11.962 (0.75 * 1.4308 + 0.25) = 15.83 (docs/verification/stiffness.md 4.3)
     assert iso_mesh_stiffness(s.c_single, 1.4308) / N_MM_UM == pytest.approx(15.827, abs=0.002)
     # aluminium-like E = 69 GPa scales linearly
     al = iso_stiffness(pair, 69e9)

@@ -15,7 +15,7 @@ import pytest
 from geardyn import paper_case
 from geardyn.diagnostics import diagnose
 from geardyn.studies.sweep import GeardynEvaluator, diagnostic_features, evaluate_run
-from geardyn.studies.sweep.evaluate import _MAPS, _METRICS, _STATISTICS, _stiffness_map
+from geardyn.studies.sweep.evaluate import _METRICS, _STATISTICS, _cached_map, _stiffness_map
 from geardyn.studies.sweep.spec import StoreSpec
 
 #: Short runs on a coarse map (about 2.5 revolutions recorded).
@@ -83,10 +83,13 @@ def test_evaluate_run_end_to_end():
 
 def test_map_memo_by_inputs_and_seeded_noise():
     case = paper_case(SHORT)
+    _cached_map.cache_clear()
     m1 = _stiffness_map(case)
     assert _stiffness_map(case.with_overrides({"motor.torque": 80.0})) is m1  # same inputs
     deeper = _stiffness_map(case.with_overrides({"crack.depth": 0.002}))
-    assert deeper is not m1 and deeper.attrs["inputs_hash"] in _MAPS
+    assert deeper is not m1 and deeper.attrs["inputs_hash"] != m1.attrs["inputs_hash"]
+    info = _cached_map.cache_info()
+    assert (info.hits, info.misses, info.currsize, info.maxsize) == (1, 2, 2, 32)
     noisy = StoreSpec(noise_snr_db=20.0, tsa=True)
     a = evaluate_run(case, noisy, seed=5)
     b = evaluate_run(case, noisy, seed=5)

@@ -210,3 +210,62 @@ def test_relative_base_case_and_shipped_example(tmp_path):
     np.testing.assert_allclose(np.unique(p.values["pinion.bearing_stiffness"]),
                                [5e5, 1e6, 2e6], rtol=1e-12)
     assert math.isclose(ex.base_case.stiffness.centre_distance_max, 3.8e-3)
+
+
+def test_a_huge_grid_is_refused_before_it_is_expanded(monkeypatch):
+    """1e6 x 1e6 runs: refused at once (before any value is expanded), with the count, the
+    limit and how to raise it; the limit is the caller's to raise."""
+    from geardyn.studies.sweep import DEFAULT_MAX_RUNS
+
+    huge = textwrap.dedent("""
+        [axes]
+        motor.torque = { start = "50 N m", stop = "150 N m", num = 1000000 }
+        load.speed = { start = "80 rad/s", stop = "150 rad/s", num = 1000000 }
+    """)
+    with pytest.raises(InputError) as info:
+        parse_sweep(huge)
+    msg = str(info.value)
+    assert "1,000,000,000,000 runs" in msg and f"{DEFAULT_MAX_RUNS:,}" in msg
+    assert "--max-runs" in msg and "GEARDYN_MAX_RUNS" in msg
+    small = '[axes]\nmotor.torque = ["50 N m", "60 N m", "70 N m"]\n[sample]\nmethod = "lhs"\n' \
+            'n = 2\n[sample.dimensions]\nload.speed = { low = "80 rad/s", high = "90 rad/s" }\n'
+    with pytest.raises(InputError, match="got '6 runs'; allowed: at most 5 runs"):
+        parse_sweep(small, max_runs=5)
+    assert parse_sweep(small, max_runs=6).n_runs == 6
+    monkeypatch.setenv("GEARDYN_MAX_RUNS", "5")
+    with pytest.raises(InputError, match="at most 5 runs"):
+        parse_sweep(small)
+    monkeypatch.setenv("GEARDYN_MAX_RUNS", "many")
+    with pytest.raises(InputError, match="GEARDYN_MAX_RUNS"):
+        parse_sweep(small)
+    # a 'step' range is counted once resolved
+    monkeypatch.delenv("GEARDYN_MAX_RUNS")
+    with pytest.raises(InputError, match="got '201 runs'"):
+        parse_sweep('[axes]\nmotor.torque = { start = "50 N m", stop = "150 N m", '
+                    'step = "0.5 N m" }\n', max_runs=200)
+
+
+def test_long_axes_are_checked_at_their_bounds():
+    """An axis of more than 200 values: its extreme values are still checked against the case
+    (the bad one named by its index); the others are converted and type-checked."""
+    values = ", ".join(f'"{v} kg"' for v in [*range(1, 150), -1, *range(150, 300)])
+    with pytest.raises(InputError) as info:
+        parse_sweep(f"[axes]\npinion.mass = [{values}]\n")
+    assert info.value.field == "axes.pinion.mass[149]"
+    values = ", ".join(f'"{v} N m"' for v in range(1, 301))
+    assert parse_sweep(f"[axes]\nmotor.torque = [{values}]\n").n_runs == 300
+
+
+def test_cli_refuses_a_huge_grid_in_one_line(tmp_path):
+    import subprocess
+
+    from ._procs import GEARDYN, env
+
+    f = tmp_path / "huge.toml"
+    f.write_text('[axes]\nmotor.torque = { start = "50 N m", stop = "150 N m", num = 1000000 }\n'
+                 'load.speed = { start = "80 rad/s", stop = "150 rad/s", num = 1000000 }\n')
+    r = subprocess.run([*GEARDYN, "sweep", str(f), "--out", str(tmp_path / "o.zarr")],
+                       capture_output=True, text=True, env=env(), timeout=120)
+    assert r.returncode == 2 and "Traceback" not in r.stderr
+    assert len(r.stderr.strip().splitlines()) == 1 and "1,000,000,000,000 runs" in r.stderr
+    assert not (tmp_path / "o.zarr").exists()

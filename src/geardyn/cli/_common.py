@@ -1,13 +1,14 @@
 """Shared pieces of the command-line tool: common options, case loading, error handling.
 
 Every command takes ``--config FILE`` and repeatable ``--set dotted.key=value``. Errors a user can
-cause (:class:`geardyn.errors.GeardynError`) print one line naming the field, the value and what is
-allowed, and exit with status 2; Ctrl-C exits with 130; nothing prints a traceback unless
-``GEARDYN_DEBUG=1``.
+cause (:class:`geardyn.errors.GeardynError`) print one line (at most :data:`MAX_ERROR_CHARS`
+characters) naming the field, the value and what is allowed, and exit with status 2; Ctrl-C
+exits with 130; nothing prints a traceback unless ``GEARDYN_DEBUG=1``.
 """
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import os
 import sys
@@ -22,8 +23,8 @@ from rich.markup import escape
 from ..errors import GeardynError
 
 __all__ = ["ConfigOption", "SetOption", "OutOption", "ForceOption", "refuse_overwrite",
-           "load_case_from_cli", "handle_errors",
-           "console", "err_console", "progress_bar"]
+           "load_case_from_cli", "handle_errors", "one_line", "warning_line", "choice",
+           "console", "err_console", "progress_bar", "StageProgress", "MAX_ERROR_CHARS"]
 
 F = TypeVar("F", bound=Callable[..., Any])
 
@@ -47,8 +48,24 @@ OutOption = Annotated[
 ]
 ForceOption = Annotated[
     bool,
-    typer.Option("--force", "-f", help="Overwrite existing outputs."),
+    typer.Option("--force", "-f", help="Replace results of other inputs in the output (a re-run "
+                                       "with the same inputs needs no --force)."),
 ]
+
+#: Longest error line the CLI prints [characters].
+MAX_ERROR_CHARS = 480
+
+
+def choice(option: str, value: str | None, allowed: tuple[str, ...]) -> str | None:
+    """``value`` matched case-insensitively against ``allowed`` (None stays None)."""
+    from ..errors import InputError
+
+    if value is None:
+        return None
+    for a in allowed:
+        if value.strip().lower() == a.lower():
+            return a
+    raise InputError(option, value, " or ".join(repr(a) for a in allowed) + " (any case)")
 
 
 def refuse_overwrite(paths, force: bool, option: str = "--out") -> None:
@@ -69,6 +86,12 @@ def load_case_from_cli(config: Path | None, overrides: list[str] | None):
     return load_case(config, overrides or [])
 
 
+def one_line(text: str, limit: int = MAX_ERROR_CHARS) -> str:
+    """``text`` on one line (whitespace runs collapsed) and at most ``limit`` characters."""
+    text = " ".join(str(text).split())
+    return text if len(text) <= limit else text[: limit - 26] + " ... (message shortened)"
+
+
 def handle_errors(fn: F) -> F:
     """Turn geardyn errors into one clear line and exit code 2 (130 on Ctrl-C)."""
 
@@ -81,20 +104,20 @@ def handle_errors(fn: F) -> F:
         except GeardynError as exc:
             if os.environ.get("GEARDYN_DEBUG"):
                 raise
-            err_console.print(f"[bold red]error:[/bold red] {escape(str(exc))}", highlight=False,
-                              soft_wrap=True)
+            err_console.print(f"[bold red]error:[/bold red] {escape(one_line(str(exc)))}",
+                              highlight=False, soft_wrap=True)
             raise typer.Exit(2) from None
         except KeyboardInterrupt:
             err_console.print("[yellow]interrupted[/yellow]: finished results and caches are "
-                              "kept; re-run the same command to continue.")
+                              "kept; re-run the same command to continue.", soft_wrap=True)
             raise typer.Exit(130) from None
         except Exception as exc:  # a bug: say so briefly, keep the traceback for GEARDYN_DEBUG
             if os.environ.get("GEARDYN_DEBUG"):
                 raise
-            err_console.print(f"[bold red]internal error:[/bold red] {type(exc).__name__}: "
-                              f"{escape(str(exc))}"
-                              "\n(this is a bug in geardyn; set GEARDYN_DEBUG=1 to see the "
-                              "traceback)", highlight=False, soft_wrap=True)
+            text = one_line(f"{type(exc).__name__}: {exc}", MAX_ERROR_CHARS - 90)
+            err_console.print(f"[bold red]internal error:[/bold red] {escape(text)} (a bug in "
+                              "geardyn; GEARDYN_DEBUG=1 shows the traceback)", highlight=False,
+                              soft_wrap=True)
             raise typer.Exit(1) from None
 
     return wrapper  # type: ignore[return-value]
@@ -102,20 +125,156 @@ def handle_errors(fn: F) -> F:
 
 def progress_bar():
     """A rich progress display for long stages (writes to stderr, hidden when not a terminal
-    unless ``GEARDYN_PROGRESS=1``)."""
+    unless ``GEARDYN_PROGRESS=1``).
+
+    Its columns fit an 80-column terminal: the description is cut with an ellipsis, never
+    wrapped. Tasks take a ``count`` field (the text shown as "done/total"); :class:`StageProgress`
+    on top of it turns a library ``progress(stage, done, total)`` callback into one bar per stage.
+    """
     from rich.progress import (
         BarColumn,
-        MofNCompleteColumn,
         Progress,
         TextColumn,
         TimeElapsedColumn,
         TimeRemainingColumn,
     )
+    from rich.table import Column
 
     disable = not (err_console.is_terminal or os.environ.get("GEARDYN_PROGRESS"))
-    return Progress(TextColumn("[bold]{task.description}"), BarColumn(), MofNCompleteColumn(),
-                    TimeElapsedColumn(), TimeRemainingColumn(), console=err_console,
-                    disable=disable, transient=False)
+    return Progress(
+        TextColumn("[bold]{task.description}",
+                   table_column=Column(width=30, no_wrap=True, overflow="ellipsis")),
+        BarColumn(bar_width=16),
+        _CountColumn(table_column=Column(width=13, no_wrap=True, justify="right")),
+        TimeElapsedColumn(), TimeRemainingColumn(), console=err_console, disable=disable,
+        transient=False, expand=False)
+
+
+def _count_text(task) -> str:
+    """A task's ``count`` field, else ``done/total`` (``done`` alone without a total)."""
+    if "count" in task.fields:
+        return str(task.fields["count"])
+    done = int(task.completed)
+    return f"{done}/{int(task.total)}" if task.total else (str(done) if done else "")
+
+
+def _make_count_column():
+    from rich.progress import ProgressColumn
+    from rich.text import Text
+
+    class CountColumn(ProgressColumn):
+        """``done/total`` of a task, or its ``count`` field (see :class:`StageProgress`)."""
+
+        def render(self, task):
+            return Text(_count_text(task), style="progress.download", justify="right")
+
+    return CountColumn
+
+
+def _CountColumn(**kw):  # noqa: N802 - a column factory (rich is imported lazily)
+    return _make_count_column()(**kw)
+
+
+class StageProgress:
+    """A ``progress(stage, done, total)`` callback drawing one bar per stage on a
+    :func:`progress_bar`.
+
+    Each distinct stage gets its own bar with its own count ("11/11"), so a stage never shows
+    another stage's count; when a new stage starts, the previous bar is shown finished. A
+    ``total`` of 0 or None is a step without a count (no "0/0"). Text after ": " in ``stage`` is
+    the bar's current item and does not start a new bar (``"simulation: model II, cracked"``
+    updates the ``simulation`` bar).
+
+    ``stages`` names a pipeline's top-level stages: a call ``(name, i, len(stages))`` announces
+    stage ``name`` (it is not a count of that stage). An announced stage gets a bar of its own
+    only if no sub-stage bar replaces it (``"stiffness"`` is shown by its ``"stiffness (healthy)"``
+    and ``"stiffness (cracked)"`` bars); ``"done"`` ends the pipeline.
+
+    If ``$GEARDYN_TEST_READY_FILE`` is set, each stage's name is appended to that file as the
+    stage starts (the interrupt tests wait on it instead of sleeping).
+    """
+
+    def __init__(self, bar, prefix: str = "", stages: tuple[str, ...] = ()):
+        self.bar = bar
+        self.prefix = prefix
+        self.stages = tuple(stages)
+        self.tasks: dict[str, Any] = {}
+        self.totals: dict[str, int] = {}
+        self.updated: set[str] = set()
+        self.current: str | None = None
+        self.ready_file = os.environ.get("GEARDYN_TEST_READY_FILE")
+
+    def __call__(self, stage: str, done: int = 0, total: int | None = None) -> None:
+        key, _, item = str(stage).partition(": ")
+        total = int(total) if total else 0
+        announce = bool(self.stages) and not item and total == len(self.stages) and (
+            key in self.stages or key == "done")
+        if announce and key == "done":
+            self.close()
+            return
+        if announce:
+            self._start(key, f"{self.prefix}{key}", 0)
+            self._touch(key)
+            return
+        label = f"{self.prefix}{key}" + (f": {item}" if item else "")
+        if self._start(key, label, total):
+            self._touch(key)
+        self.totals[key] = total
+        self.updated.add(key)
+        self.bar.update(self.tasks[key], description=label, completed=done,
+                        total=total or None, count=f"{done}/{total}" if total else "")
+
+    def _start(self, key: str, label: str, total: int) -> bool:
+        """Make ``key`` the current bar; True if it is new."""
+        if key == self.current:
+            return False
+        cur = self.current
+        if cur is not None and cur in self.stages and cur not in self.updated \
+                and key not in self.stages:
+            # an announced stage shown by its sub-stages' bars: drop its own empty bar
+            self.bar.remove_task(self.tasks.pop(cur))
+            self.current = None
+        self._finish_current()
+        self.current = key
+        if key in self.tasks:
+            return False
+        self.tasks[key] = self.bar.add_task(label, total=total or None, count="")
+        self.totals[key] = total
+        return True
+
+    def stage(self, name: str) -> Callable[[int, int], None]:
+        """A ``progress(done, total)`` callback for one named stage."""
+        return lambda done, total: self(name, done, total)
+
+    def _finish_current(self) -> None:
+        key, self.current = self.current, None
+        if key is None or key not in self.tasks:
+            return
+        task, total = self.tasks[key], self.totals.get(key, 0)
+        label = f"{self.prefix}{key}"
+        if total:
+            self.bar.update(task, description=label, completed=total, count=f"{total}/{total}")
+        else:
+            self.bar.update(task, description=label, total=1, completed=1, count="done")
+        self.bar.stop_task(task)
+
+    def close(self) -> None:
+        """Show the last stage finished (call it when the work succeeded)."""
+        self._finish_current()
+
+    def _touch(self, key: str) -> None:
+        if self.ready_file:
+            with contextlib.suppress(OSError), open(self.ready_file, "a", encoding="utf-8") as fh:
+                fh.write(key + "\n")
+
+
+def warning_line(message, category, filename=None, lineno=None, file=None, line=None) -> None:
+    """A :func:`warnings.showwarning` replacement: one clean line on stderr (no source path, no
+    code), e.g. ``warning: Sainsot's fit is used outside its range ...``."""
+    name = getattr(category, "__name__", "Warning")
+    tag = "warning" if name in ("UserWarning", "Warning") else f"warning ({name})"
+    err_console.print(f"[yellow]{tag}[/yellow]: {escape(one_line(str(message)))}",
+                      highlight=False, soft_wrap=True)
 
 
 def exit_code_of(exc: BaseException) -> int:  # pragma: no cover - helper for scripts

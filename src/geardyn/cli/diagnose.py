@@ -15,19 +15,20 @@ from ._common import (
     console,
     handle_errors,
     load_case_from_cli,
-    refuse_overwrite,
 )
 
 
 @app.command("diagnose")
 @handle_errors
 def diagnose(
-    file: Annotated[Path, typer.Argument(help="A geardyn simulation (.nc) or measured data "
+    file: Annotated[Path, typer.Argument(metavar="FILE", help="A geardyn simulation (.nc) or measured data "
                                               "(.csv, .txt, .npy, .npz, .mat).")],
     config: ConfigOption = None,
     set_: SetOption = None,
-    out: Annotated[Path, typer.Option("--out", "-o", help="Output folder for metrics.json and "
-                                                          "figures/.")] = Path("geardyn-out/diagnose"),
+    out: Annotated[Path | None, typer.Option(
+        "--out", "-o", help="Output folder for metrics.json and figures/ (default: "
+                            "<FILE without suffix>-diagnose beside FILE).", show_default=False)
+                   ] = None,
     signal: Annotated[list[str] | None, typer.Option(
         "--signal", help="Signal column/variable (repeatable). Default for a simulation: "
                          "v_yg, omega_p, transmission_error.", show_default=False)] = None,
@@ -35,8 +36,9 @@ def diagnose(
         "--teeth", help="Teeth on the shaft whose angle is given (default: the simulation's "
                         "pinion, or the case's pinion for measured data).",
         show_default=False)] = None,
-    fs: Annotated[float | None, typer.Option("--fs", help="Sampling rate [Hz] of measured data.",
-                                             show_default=False)] = None,
+    fs: Annotated[str | None, typer.Option("--fs", help="Sampling rate of measured data: Hz, or "
+                                                        "with a unit (Hz, kHz, MHz, 1/s), e.g. "
+                                                        "'20 kHz'.", show_default=False)] = None,
     time: Annotated[str | None, typer.Option("--time", help="Time column [s] (instead of --fs).",
                                              show_default=False)] = None,
     angle: Annotated[str | None, typer.Option("--angle", help="Shaft angle column.",
@@ -56,10 +58,35 @@ def diagnose(
 ) -> None:
     """Run TSA, spectra, residual, demodulation, PWVD and condition metrics; write figures and
     metrics.json into OUT."""
+    from ..errors import DataFileError
+    from ..units import parse_frequency
+    from ._outputs import (
+        begin,
+        check_writable,
+        claim_folder,
+        identity,
+        mark_complete,
+        resolve,
+        say_state,
+    )
+
+    fs = parse_frequency(fs, "--fs") if fs is not None else None  # [Hz]; "20 kHz" -> 20000.0
+    if not file.exists():
+        raise DataFileError(file, "no such file")
+    if not file.is_file():
+        raise DataFileError(file, "is not a file (a folder?)")
+    target = resolve(out, file.with_name(f"{file.stem}-diagnose"))
+    out = target.path
+    check_writable(target)  # before loading anything heavy: a bad --out fails at once
+    case = load_case_from_cli(config, set_)
+    options = {"signal": signal or None, "teeth": teeth, "fs": fs, "time": time, "angle": angle,
+               "angle_unit": angle_unit, "tach": tach, "tach_times": tach_times,
+               "pulses_per_rev": pulses_per_rev, "figures": figures}
+    ident = identity("diagnose", case, options, files={"FILE": file})
+    state = claim_folder(target, ident, force=force, results=["metrics.json", "figures"],
+                         record=False)
     from ..diagnostics import diagnose_file
 
-    case = load_case_from_cli(config, set_)
-    refuse_overwrite([out / "metrics.json"], force)
     d = case.diagnostics
     is_sim = file.suffix.lower() in (".nc", ".nc4", ".netcdf")
     if teeth is None and not is_sim:
@@ -69,7 +96,10 @@ def diagnose(
         tach_column_is_pulse_times=tach_times, pulses_per_rev=pulses_per_rev,
         angle_unit=angle_unit, samples_per_rev=d.samples_per_rev, harmonic=d.harmonic,
         bandwidth=d.bandwidth, residual_preset=d.residual_preset)
+    say_state(state, target)
+    begin(target, ident)
     result.write(out, figures=figures)
+    mark_complete(target, ident)
     summary = result.to_dict()
     console.print(f"[green]done[/green]: metrics and figures in {out}/")
     def num(v) -> str:

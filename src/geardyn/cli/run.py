@@ -12,13 +12,20 @@ from ._common import (
     ConfigOption,
     ForceOption,
     SetOption,
+    StageProgress,
+    choice,
     console,
     err_console,
     handle_errors,
     load_case_from_cli,
     progress_bar,
-    refuse_overwrite,
 )
+
+#: Default output folder of ``geardyn run``.
+DEFAULT_OUT = Path("geardyn-out")
+
+#: Files whose presence (without an inputs record) means a folder holds earlier results.
+RESULTS = ["summary.json", "report.html", "results.nc", "geometry.json", "case.toml"]
 
 
 @app.command("run")
@@ -26,29 +33,52 @@ from ._common import (
 def run(
     config: ConfigOption = None,
     set_: SetOption = None,
-    out: Annotated[Path, typer.Option("--out", "-o", help="Output folder.")] = Path("geardyn-out"),
+    out: Annotated[Path | None, typer.Option(
+        "--out", "-o", help=f"Output folder (default: {DEFAULT_OUT}). Re-running the same command "
+                            "into it continues or repeats the run (fast: the cache keeps the "
+                            "maps and simulations).", show_default=False)] = None,
     quick: Annotated[bool, typer.Option("--quick", help="Shorter simulations, coarser maps.")
                      ] = False,
     stiffness: Annotated[str | None, typer.Option(
-        "--stiffness", help="Mesh stiffness method: fe or pem (default: the case's).",
-        show_default=False)] = None,
+        "--stiffness", help="Mesh stiffness method: fe or pem, any case (default: the case's "
+                            "stiffness.method).", show_default=False)] = None,
     force: ForceOption = False,
 ) -> None:
     """Reproduce the paper's case study (model I vs II, healthy and cracked) into OUT."""
-    from ..errors import InputError
-    from ..studies.paper import run_paper_study
+    from ..run_limits import check_step_count
+    from ._outputs import (
+        check_writable,
+        claim_folder,
+        identity,
+        mark_complete,
+        resolve,
+        say_cache,
+        say_state,
+    )
 
-    if stiffness is not None and stiffness not in ("fe", "pem"):
-        raise InputError("--stiffness", stiffness, "'fe' or 'pem'")
+    stiffness = choice("--stiffness", stiffness, ("fe", "pem"))
+    target = resolve(out, DEFAULT_OUT)
+    check_writable(target)  # before loading anything heavy: a bad --out fails at once
     case = load_case_from_cli(config, set_)
-    refuse_overwrite([out / "summary.json", out / "report.html"], force)
-    with progress_bar() as bar:
-        task = bar.add_task("geardyn run", total=None)
+    if stiffness is not None:
+        case = case.with_overrides({"stiffness.method": stiffness})
+    from ..studies.paper import _simulation_case
 
-        def progress(stage: str, done: int, total: int) -> None:
-            bar.update(task, description=f"run: {stage}", completed=done, total=total)
+    check_step_count(_simulation_case(case, quick).simulation)  # before the heavy imports
 
-        result = run_paper_study(case, out, quick=quick, stiffness=stiffness, progress=progress)
+    from ..cache import record_lookups
+    from ..dynamics.newmark import check_bounded_work
+    from ..studies.paper import STAGES, run_paper_study
+
+    check_bounded_work(_simulation_case(case, quick))
+    ident = identity("run", case, {"quick": quick})
+    state = claim_folder(target, ident, force=force, results=RESULTS)
+    say_state(state, target)
+    with progress_bar() as bar, record_lookups() as lookups:
+        progress = StageProgress(bar, "run: ", stages=tuple(name for name, _ in STAGES))
+        result = run_paper_study(case, target.path, quick=quick, progress=progress)
+        progress.close()
+    mark_complete(target, ident, lookups)
     s = result.summary
     from rich.markup import escape
     from rich.table import Table
@@ -78,6 +108,7 @@ def run(
     for v in failed:
         err_console.print(f"[yellow]outside tolerance[/yellow]: {escape(v['quantity'])}: "
                           f"geardyn {v['geardyn']:.4g}, paper {v['paper']:.4g}")
+    say_cache(lookups)
     report = result.out / "report.html"
     if report.exists():
         console.print(f"report: [bold]{escape(str(report))}[/bold] (self-contained; open it in "

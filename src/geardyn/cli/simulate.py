@@ -13,13 +13,36 @@ from ._common import (
     ConfigOption,
     ForceOption,
     SetOption,
+    StageProgress,
+    choice,
     console,
     err_console,
     handle_errors,
     load_case_from_cli,
     progress_bar,
-    refuse_overwrite,
 )
+
+#: Default output file of ``geardyn simulate``.
+DEFAULT_OUT = Path("sim.nc")
+
+
+def _recorded_identity(path: Path) -> tuple[dict | None, int | None]:
+    """The inputs identity and ``complete`` flag a geardyn record carries (None if not one)."""
+    import json
+
+    import h5py
+    import numpy as np
+
+    try:
+        with h5py.File(path, "r") as f:
+            text = f.attrs.get("geardyn_inputs")
+            complete = f.attrs.get("complete")
+        text = text.decode() if isinstance(text, bytes) else text
+        ident = json.loads(text) if text else None
+        flag = np.asarray(complete).ravel()
+        return (ident if isinstance(ident, dict) else None), (int(flag[0]) if flag.size else None)
+    except (OSError, ValueError, TypeError):
+        return None, None
 
 
 @app.command("simulate")
@@ -29,61 +52,98 @@ def simulate(
     set_: SetOption = None,
     model: Annotated[str | None, typer.Option(
         "--model", "-m", help="I: stiffness at the design centre distance; II: iterated with the "
-                              "operating centre distance (default: the case's simulation.model).",
-        show_default=False)] = None,
+                              "operating centre distance; any case (default: the case's "
+                              "simulation.model).", show_default=False)] = None,
     crack: Annotated[bool, typer.Option("--crack/--no-crack",
                                         help="Include the case's tooth crack in the stiffness.")
                      ] = True,
-    out: Annotated[Path, typer.Option("--out", "-o", help="Output NetCDF file.")
-                   ] = Path("sim.nc"),
+    out: Annotated[Path | None, typer.Option(
+        "--out", "-o", help=f"Output NetCDF file (default: {DEFAULT_OUT}). Re-running the same "
+                            "command finds it up to date.", show_default=False)] = None,
     mat: Annotated[bool, typer.Option("--mat", help="Also write a MATLAB .mat file beside it.")
                    ] = False,
     stiffness: Annotated[str | None, typer.Option(
-        "--stiffness", help="Mesh stiffness method: pem or fe (default: the case's).",
-        show_default=False)] = None,
+        "--stiffness", help="Mesh stiffness method: pem or fe, any case (default: the case's "
+                            "stiffness.method).", show_default=False)] = None,
     force: ForceOption = False,
 ) -> None:
     """Simulate the gear pair (Newmark, paper section 4) and write the record to OUT."""
+    import json
+
+    from ..run_limits import check_step_count
+    from ._outputs import (
+        OutputInUse,
+        check_writable,
+        differences,
+        identity,
+        refuse_different,
+        resolve,
+    )
+
+    model = choice("--model", model, ("I", "II"))
+    stiffness = choice("--stiffness", stiffness, ("pem", "fe"))
+    target = resolve(out, DEFAULT_OUT)
+    out = target.path
+    check_writable(target, folder=False)  # before loading anything heavy
+    case = load_case_from_cli(config, set_)
+    which = model or case.simulation.model
+    method = stiffness or case.stiffness.method
+    check_step_count(case.simulation)  # a run that would not end is refused before the imports
+
     from ..dynamics import save_mat, save_netcdf, summary
     from ..dynamics import simulate as run_simulation
-    from ..errors import InputError, NumericalError
+    from ..dynamics.newmark import check_bounded_work
+    from ..errors import NumericalError
+    from ..io import read_netcdf
     from ..stiffness import build_map
 
-    case = load_case_from_cli(config, set_)
-    which = case.simulation.model if model is None else model.strip().upper()
-    if which not in ("I", "II"):
-        raise InputError("--model", model, "I or II")
-    if stiffness is not None and stiffness not in ("pem", "fe"):
-        raise InputError("--stiffness", stiffness, "'pem' or 'fe'")
-    if out.exists() and out.is_dir():
-        raise InputError("--out", str(out), "a file path (it is a folder)")
-    refuse_overwrite([out] + ([out.with_suffix(".mat")] if mat else []), force)
-    with progress_bar() as bar:
-        task = bar.add_task("stiffness map", total=None)
-
-        def map_progress(done: int, total: int) -> None:
-            bar.update(task, completed=done, total=total)
-
-        smap = build_map(case, method=stiffness, cracked=crack, progress=map_progress)
-        bar.update(task, description=f"model {which}", completed=0, total=None)
-
-        def sim_progress(done: int, total: int) -> None:
-            bar.update(task, completed=done, total=total)
-
-        try:
-            ds = run_simulation(case, smap, model=which, cracked=crack, progress=sim_progress)
-        except NumericalError as exc:
-            partial = getattr(exc, "partial", None)
-            if partial is not None and partial.sizes.get("time", 0):
-                save_netcdf(partial, out)
-                err_console.print(f"[yellow]partial record[/yellow] ({partial.sizes['time']} "
-                                  f"samples, complete = 0) written to {out}")
-            raise
-    save_netcdf(ds, out)
+    check_bounded_work(case)
+    ident = identity("simulate", case, {"model": which, "crack": crack, "stiffness": method})
+    mat_path = out.with_suffix(".mat")
+    up_to_date = False
+    if out.exists():
+        old, complete = _recorded_identity(out)
+        diff = differences(old, ident) if old is not None else None
+        if diff and not force:
+            raise refuse_different(target, diff)
+        if old is None and not force:
+            raise OutputInUse(target.label, "is an existing file that is not a geardyn record "
+                                            "of known inputs", "pass --force to replace it, or "
+                                                              "choose another file with --out")
+        up_to_date = diff == [] and complete == 1
+    elif mat and mat_path.exists() and not force:
+        raise OutputInUse(target.label, f"has no record but {mat_path} exists",
+                          "pass --force to replace it, or choose another file with --out")
+    if up_to_date:
+        ds = read_netcdf(out)
+        err_console.print(f"[dim]{out} is up to date (same inputs); --force recomputes it[/dim]",
+                          highlight=False, soft_wrap=True)
+    else:
+        with progress_bar() as bar:
+            progress = StageProgress(bar)
+            progress(f"{method} map", 0, 0)
+            smap = build_map(case, method=method, cracked=crack,
+                             progress=progress.stage(f"{method} map"))
+            progress(f"model {which}", 0, 0)
+            try:
+                ds = run_simulation(case, smap, model=which, cracked=crack,
+                                    progress=progress.stage(f"model {which}"))
+            except NumericalError as exc:
+                partial = getattr(exc, "partial", None)
+                if partial is not None and partial.sizes.get("time", 0):
+                    partial.attrs["geardyn_inputs"] = json.dumps(ident)
+                    save_netcdf(partial, out)
+                    err_console.print(f"[yellow]partial record[/yellow] "
+                                      f"({partial.sizes['time']} samples, complete = 0) written "
+                                      f"to {out}")
+                raise
+            progress.close()
+        ds.attrs["geardyn_inputs"] = json.dumps(ident)
+        save_netcdf(ds, out)
     written = [str(out)]
-    if mat:
-        mat_path = out.with_suffix(".mat")
+    if mat and (not up_to_date or not mat_path.exists()):
         save_mat(ds, mat_path)
+    if mat:
         written.append(str(mat_path))
     s = summary(ds)
     console.print(f"[green]done[/green]: model {which}, {ds.sizes['time']} samples over "

@@ -15,12 +15,13 @@ from ._common import (
     ConfigOption,
     ForceOption,
     SetOption,
+    StageProgress,
+    choice,
     console,
     err_console,
     handle_errors,
     load_case_from_cli,
     progress_bar,
-    refuse_overwrite,
 )
 
 
@@ -34,46 +35,73 @@ def _map_warnings(m) -> list[str]:
     return [str(x) for x in w]
 
 
+#: Default output folder of ``geardyn stiffness``.
+DEFAULT_OUT = Path("geardyn-out/stiffness")
+
+#: Files this command writes (a folder holding one without an inputs record is not overwritten).
+RESULTS = ["stiffness_healthy.nc", "stiffness_cracked.nc", "fig5_stiffness.png",
+           "fig5_load_sharing.png", "fig6_crack.png", "fe_mesh.png"]
+
+
 @app.command("stiffness")
 @handle_errors
 def stiffness(
     config: ConfigOption = None,
     set_: SetOption = None,
-    method: Annotated[str, typer.Option(
-        "--method", "-m", help="Mesh stiffness method: pem (potential energy) or fe.")] = "pem",
-    out: Annotated[Path, typer.Option("--out", "-o", help="Output folder.")
-                   ] = Path("geardyn-out/stiffness"),
+    method: Annotated[str | None, typer.Option(
+        "--method", "--stiffness", "-m", help="Mesh stiffness method: pem (potential energy) or "
+                                              "fe, any case (default: the case's "
+                                              "stiffness.method).", show_default=False)] = None,
+    out: Annotated[Path | None, typer.Option(
+        "--out", "-o", help=f"Output folder (default: {DEFAULT_OUT}).", show_default=False)
+                   ] = None,
     force: ForceOption = False,
 ) -> None:
     """Compute (or load from the cache) the stiffness maps and plot Figs. 5 and 6 into OUT."""
+    from ._outputs import (
+        begin,
+        check_writable,
+        claim_folder,
+        identity,
+        mark_complete,
+        resolve,
+        say_cache,
+        say_state,
+    )
+
+    method = choice("--method", method, ("pem", "fe"))
+    target = resolve(out, DEFAULT_OUT)
+    check_writable(target)  # before loading anything heavy: a bad --out fails at once
+    case = load_case_from_cli(config, set_)
+    method = method or case.stiffness.method
+    out = target.path
+    has_crack = case.crack is not None and case.crack.enabled
+    ident = identity("stiffness", case, {"method": method})
+    state = claim_folder(target, ident, force=force, results=RESULTS, record=False)
+
     import numpy as np
 
-    from ..errors import InputError
+    from ..cache import record_lookups
     from ..io import atomic_path
     from ..stiffness import build_map
     from ..stiffness.plots import fig_crack, fig_load_sharing, fig_stiffness
 
-    if method not in ("pem", "fe"):
-        raise InputError("--method", method, "'pem' or 'fe'")
-    case = load_case_from_cli(config, set_)
-    refuse_overwrite([out / "stiffness_healthy.nc", out / "stiffness_cracked.nc"], force)
-    has_crack = case.crack is not None and case.crack.enabled
     maps = {}
-    with progress_bar() as bar, warnings.catch_warnings():
+    with progress_bar() as bar, warnings.catch_warnings(), record_lookups() as lookups:
         # the maps carry their validity notes in attrs["warnings"]; printed below once
         warnings.simplefilter("ignore", UserWarning)
+        progress = StageProgress(bar)
         for name, cracked in (("healthy", False), ("cracked", True)):
             if cracked and not has_crack:
                 continue
-            task = bar.add_task(f"{method} map, {name}", total=case.stiffness.centre_distances)
+            label = f"{method} map, {name}"
+            progress(label, 0, 0)  # visible at once (an FE mesh comes before any count)
+            maps[name] = build_map(case, method=method, cracked=cracked,
+                                   progress=progress.stage(label))
+        progress.close()
 
-            def progress(done: int, total: int, task=task) -> None:
-                bar.update(task, completed=done, total=total)
-
-            maps[name] = build_map(case, method=method, cracked=cracked, progress=progress)
-            bar.update(task, completed=case.stiffness.centre_distances)
-
-    out.mkdir(parents=True, exist_ok=True)
+    say_state(state, target)
+    begin(target, ident)
     written = []
     for name, m in maps.items():
         path = out / f"stiffness_{name}.nc"
@@ -111,6 +139,13 @@ def stiffness(
     notes = sorted({w for m in maps.values() for w in _map_warnings(m)})
     for w in notes:
         err_console.print(f"[yellow]note[/yellow]: {w}", highlight=False)
+    if not has_crack:
+        for stale in ("stiffness_cracked.nc", "fig6_crack.png"):  # from earlier inputs (--force)
+            (out / stale).unlink(missing_ok=True)
+    if method != "fe":
+        (out / "fe_mesh.png").unlink(missing_ok=True)
+    mark_complete(target, ident, lookups)
+    say_cache(lookups)
     if not has_crack:
         console.print("no enabled crack in the case: only the healthy map and Fig. 5 written")
     console.print(f"[green]wrote[/green] {', '.join(written)} -> {out}/")

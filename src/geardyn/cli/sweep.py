@@ -4,7 +4,8 @@ The sweep file holds the base case, its overrides and the swept values; ``--conf
 base case and ``--set`` adds overrides to it. Both become part of the sweep's identity (a store
 made with other values is not resumed by mistake) and are recorded with the sweep file's text in
 the Zarr attributes. Re-running the same command after an interruption computes only the missing
-runs.
+runs; batches whose stored values fail their checksums are computed again (and named).
+``geardyn sweep --verify STORE`` checks a store against its checksums without computing.
 """
 
 from __future__ import annotations
@@ -54,21 +55,51 @@ def with_base_case(sw, config: Path | None, overrides: list[str]):
         return sw
     base = sw.base_case
     if config is not None:
-        base = load_case(config, {k: v for k, v in (sw.spec.set or {}).items()})
+        base = load_case(config, {k: v for k, v in (sw.spec.set or {}).items()},
+                         override_source="sweep file [set]")
     if overrides:
-        base = base.with_overrides(overrides)
+        base = base.with_overrides(overrides, source="--set")
     cli = " ".join(([f"--config {shlex.quote(str(config))}"] if config else [])
                    + [f"--set {shlex.quote(o)}" for o in overrides])
     return dataclasses.replace(sw, base_case=base,
                                text=sw.text.rstrip("\n") + f"\n# geardyn sweep {cli}\n")
 
 
+def verify(store: Path) -> None:
+    """``--verify STORE``: check every finished batch against its checksum; exit 1 if damaged."""
+    from ..studies.sweep import verify_store
+
+    check = verify_store(store)
+    if check.metadata == "missing":
+        err_console.print("  [yellow]note[/yellow]: the consolidated metadata (.zmetadata) is "
+                          "missing or unreadable; resuming the sweep rebuilds it", soft_wrap=True)
+    if check.ok:
+        console.print(f"[green]ok[/green]: {store}: {check.summary()}", highlight=False,
+                      soft_wrap=True)
+        return
+    err_console.print(f"[red]damaged[/red]: {store}: {check.summary(10)}", highlight=False,
+                      soft_wrap=True)
+    err_console.print("  re-run the same `geardyn sweep` command to recompute those runs",
+                      soft_wrap=True)
+    raise typer.Exit(1)
+
+
 @app.command("sweep")
 @handle_errors
 def sweep(
-    sweep_file: Annotated[Path, typer.Argument(help="Sweep file (TOML).", show_default=False)],
-    out: Annotated[Path, typer.Option("--out", "-o", help="Zarr store to create or resume "
-                                                          "(a folder).", show_default=False)],
+    sweep_file: Annotated[Path | None, typer.Argument(help="Sweep file (TOML).",
+                                                      show_default=False)] = None,
+    out: Annotated[Path | None, typer.Option("--out", "-o", help="Zarr store to create or "
+                                                                 "resume (a folder).",
+                                             show_default=False)] = None,
+    verify_store: Annotated[Path | None, typer.Option(
+        "--verify", help="Check the store STORE against its per-batch checksums without "
+                         "computing (exit 1 if a batch is damaged), instead of running a "
+                         "sweep.", metavar="STORE", show_default=False)] = None,
+    max_runs: Annotated[int | None, typer.Option(
+        "--max-runs", help="Largest number of runs accepted (default 100,000, or "
+                           "$GEARDYN_MAX_RUNS); a larger sweep is refused before it starts.",
+        show_default=False)] = None,
     scheduler: Annotated[str | None, typer.Option(
         "--scheduler", help="Address of a running Dask scheduler, e.g. tcp://10.0.0.5:8786 "
                             "(default: a local cluster).", show_default=False)] = None,
@@ -88,9 +119,23 @@ def sweep(
 ) -> None:
     """Run the sweep in SWEEP_FILE on Dask into the Zarr store OUT (resumable: re-run the same
     command after an interruption to compute only the missing runs)."""
+    from .._optional import require_extra
+    from ..errors import InputError
+
+    require_extra("sweep")  # before any work: exit 2 naming pip install 'geardyn[sweep]'
     from ..studies.sweep import load_sweep, open_sweep, run_sweep
 
-    sw = with_base_case(load_sweep(sweep_file), config, set_ or [])
+    if verify_store is not None:
+        if sweep_file is not None or out is not None:
+            raise InputError("--verify", str(verify_store), "a store alone (no sweep file, no "
+                                                            "--out)")
+        verify(verify_store)
+        return
+    if sweep_file is None:
+        raise InputError("SWEEP_FILE", None, "a sweep file (TOML), or --verify STORE")
+    if out is None:
+        raise InputError("--out", None, "the Zarr store to create or resume (a folder)")
+    sw = with_base_case(load_sweep(sweep_file, max_runs=max_runs), config, set_ or [])
     ev = _load_evaluator(evaluator) if evaluator else None
     with progress_bar() as bar:
         task = bar.add_task(f"sweep {sw.spec.name}", total=sw.n_runs)
@@ -102,13 +147,22 @@ def sweep(
                            retry_failed=retry_failed, force=force, evaluate=ev,
                            progress=progress)
     what = "resumed" if result.resumed else "created"
+    if result.metadata_rebuilt:
+        err_console.print("  [yellow]repaired[/yellow]: the store's consolidated metadata was "
+                          "missing or unreadable and was rebuilt", soft_wrap=True)
+    if result.damaged:
+        err_console.print(f"  [yellow]repaired[/yellow]: {len(result.damaged)} batch(es) failed "
+                          "their checksums and were computed again: "
+                          + "; ".join(result.damaged[:5])
+                          + ("; ..." if len(result.damaged) > 5 else ""),
+                          highlight=False, soft_wrap=True)
     console.print(f"[green]done[/green]: {result.n_runs} runs in {result.out} ({what}; "
                   f"{result.computed} computed now on {result.workers} worker(s) in "
                   f"{result.tasks} task(s) of up to {result.batch_size} runs, "
                   f"{result.seconds:.1f} s)")
     console.print(f"  ok {result.ok}, failed {result.failed}, pending {result.pending}")
     if result.failed:
-        ds = open_sweep(result.out)
+        ds = open_sweep(result.out, verify=False)  # verified by the resume; only read errors
         errors = ds["error"].values[ds["status"].values == 2]
         for msg, n in Counter(str(e) for e in errors).most_common(3):
             err_console.print(f"  [yellow]{n} failed[/yellow]: {msg}", highlight=False,

@@ -44,7 +44,7 @@ from geardyn.errors import InputError
 
 from .tsa import DiagnosticsWarning, _as_float_array, _check_int
 
-__all__ = ["DemodulationResult", "narrowband_demodulation", "band_limits"]
+__all__ = ["DemodulationResult", "narrowband_demodulation", "band_limits", "band_analytic_signal"]
 
 
 @dataclass(frozen=True)
@@ -153,6 +153,39 @@ def band_limits(teeth: int, harmonic: int, bandwidth: int, samples_per_rev: int)
     return k - b, k + b
 
 
+def _band_spectrum(xa: np.ndarray, lo: int, hi: int) -> np.ndarray:
+    """Spectrum of the analytic band signal: ``2 X_k`` for ``lo <= k <= hi``, zero elsewhere."""
+    spec = sfft.fft(xa)
+    band = np.zeros(xa.shape[0], dtype=np.complex128)
+    band[lo: hi + 1] = 2.0 * spec[lo: hi + 1]
+    return band
+
+
+def band_analytic_signal(x, *, teeth: int, harmonic: int, bandwidth: int) -> np.ndarray:
+    """Analytic signal of the band ``K - B .. K + B`` of a one-revolution TSA (K = h Z).
+
+    .. math:: z_n = \\frac1N \\sum_{k=K-B}^{K+B} 2X_k e^{2\\pi i kn/N}
+
+    The same band signal as :func:`narrowband_demodulation` (whose ``analytic`` it equals);
+    its modulus is the band envelope of NB4 (:func:`geardyn.diagnostics.band_envelope`).
+
+    Parameters
+    ----------
+    x : array_like, shape (N,)
+        One-revolution TSA (unit u).
+    teeth, harmonic, bandwidth : int
+        Z [-], h [-] and B [orders]; checked by :func:`band_limits`.
+
+    Returns
+    -------
+    ndarray of complex, shape (N,)
+        z (unit u).
+    """
+    xa = _as_float_array(x, "x", min_size=8)
+    lo, hi = band_limits(teeth, harmonic, bandwidth, xa.shape[0])
+    return sfft.ifft(_band_spectrum(xa, lo, hi))
+
+
 def narrowband_demodulation(x, *, teeth: int, harmonic: int = 5, bandwidth: int = 11,
                             remove_mean_phase: bool = False,
                             envelope_excludes_carrier: bool = True) -> DemodulationResult:
@@ -193,9 +226,7 @@ def narrowband_demodulation(x, *, teeth: int, harmonic: int = 5, bandwidth: int 
     n = xa.shape[0]
     lo, hi = band_limits(teeth, harmonic, bandwidth, n)
     k = int(harmonic) * int(teeth)
-    spec = sfft.fft(xa)
-    band = np.zeros(n, dtype=np.complex128)
-    band[lo: hi + 1] = 2.0 * spec[lo: hi + 1]
+    band = _band_spectrum(xa, lo, hi)
     z = sfft.ifft(band)
     theta = 2.0 * np.pi * np.arange(n) / n
     # exact baseband: shift the band down by K bins (equal to z*exp(-iK theta) up to rounding)

@@ -20,14 +20,18 @@ CSV / text (``.csv``, ``.txt``, ``.tsv``, ``.dat``)
     Every 1-D array is a channel under its name; a 2-D array ``a`` gives channels ``a[0]``,
     ``a[1]``, ... (samples along the longer axis); scalars (e.g. ``fs``) go to ``scalars``.
 ``.mat``
-    MATLAB v4-v7.2 via :func:`scipy.io.loadmat`, v7.3 (HDF5) via h5py. Variables are channels
-    as for ``.npz``.
+    MATLAB v4-v7.2 via :func:`scipy.io.loadmat`, v7.3 (HDF5) via ``mat73`` (both read the
+    MATLAB class of each variable). Numeric variables are channels as for ``.npz``; the numeric
+    fields of a struct are channels named ``struct.field``; text (``char``), empty arrays,
+    cells and objects are never channels.
 """
 
 from __future__ import annotations
 
 import contextlib
+import logging
 import os
+import warnings
 import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -137,6 +141,8 @@ def read_table(path) -> DataTable:
         return _read_npz(p)
     if suffix == ".mat":
         return _read_mat(p)
+    if suffix in NETCDF_SUFFIXES:
+        return _read_netcdf_table(p)
     raise DataFileError(p, f"unsupported format {suffix!r}; use .csv/.txt/.tsv/.dat, .npy, "
                            ".npz, .mat (measured data) or .nc (geardyn simulation result)")
 
@@ -249,44 +255,114 @@ def _read_npz(p: Path) -> DataTable:
 
 
 def _read_mat(p: Path) -> DataTable:
-    import scipy.io
+    """MATLAB file: v4-v7.2 through :func:`scipy.io.loadmat`, v7.3 (HDF5) through ``mat73``.
 
+    Both readers honour the MATLAB class of each variable: ``char`` variables come back as
+    text and empty arrays as empty (or None), and neither is taken as a channel; structs come
+    back as dicts whose numeric fields are channels named ``struct.field`` (nested:
+    ``a.b.c``); cell arrays, tables and objects are not channels. Warnings the readers emit
+    while failing are dropped (the error says what is wrong); on success they are passed on.
+    """
+    import scipy.io
+    from scipy.io.matlab import matfile_version
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            with open(p, "rb") as fh:
+                major, _minor = matfile_version(fh)
+        except Exception as exc:  # scipy raises ValueError / MatReadError on a bad header
+            raise DataFileError(p, f"not a readable MATLAB file ({type(exc).__name__}: {exc})") from exc
+        if major == 2:
+            content = _load_mat73(p)
+        else:
+            try:
+                content = scipy.io.loadmat(p, simplify_cells=True)
+            except Exception as exc:  # ValueError, MatReadError, OSError, TypeError...
+                raise DataFileError(p, f"not a readable MATLAB file ({type(exc).__name__}: "
+                                       f"{exc})") from exc
     cols: dict[str, np.ndarray] = {}
     scalars: dict[str, float] = {}
-    try:
-        content = scipy.io.loadmat(p, squeeze_me=True)
-    except NotImplementedError:
-        return _read_mat73(p)
-    except Exception as exc:  # scipy raises ValueError, MatReadError, OSError, TypeError...
-        raise DataFileError(p, f"not a readable MATLAB file ({type(exc).__name__}: {exc})"
-                            ) from exc
     for name, value in content.items():
-        if name.startswith("__"):
-            continue
-        _split_2d(name, value, cols, scalars)
+        if not name.startswith("__"):
+            _mat_variable(name, value, cols, scalars)
     if not cols:
-        raise DataFileError(p, "no numeric vector or matrix variables")
+        why = f"; the reader said: {str(caught[0].message)[:200]}" if caught else ""
+        raise DataFileError(p, "no numeric vector or matrix variables (text, empty arrays, "
+                               f"cells and objects are not signals){why}")
+    for w in caught:
+        warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
     return DataTable(str(p), cols, scalars)
 
 
-def _read_mat73(p: Path) -> DataTable:
+def _load_mat73(p: Path) -> dict:
     try:
-        import h5py
-    except ImportError as exc:
-        raise DataFileError(p, "MATLAB v7.3 (HDF5) file: reading it needs h5py "
-                               "(pip install h5py), or save it with -v7") from exc
+        import mat73
+    except ImportError as exc:  # pragma: no cover - mat73 is a declared dependency
+        raise DataFileError(p, "MATLAB v7.3 (HDF5) file: reading it needs mat73 "
+                               "(pip install mat73), or save it with -v7") from exc
+    # mat73 reports skipped variables (no MATLAB class, unsupported types) through the root
+    # logger, which would print them on stderr: collect them and pass them on as warnings
+    notes: list[str] = []
+
+    def _collect(record) -> bool:
+        if record.pathname.replace("\\", "/").split("/")[-2:-1] == ["mat73"]:
+            notes.append(record.getMessage())
+            return False
+        return True
+
+    root = logging.getLogger()
+    root.addFilter(_collect)
+    try:
+        content = mat73.loadmat(str(p))
+    except Exception as exc:  # h5py OSError, mat73 TypeError/ValueError on odd content
+        raise DataFileError(p, f"not a readable MATLAB v7.3/HDF5 file ({type(exc).__name__}: "
+                               f"{exc})") from exc
+    finally:
+        root.removeFilter(_collect)
+    for note in notes:
+        warnings.warn(f"{p.name}: MATLAB v7.3 reader skipped a variable: {note}", UserWarning,
+                      stacklevel=4)
+    return content
+
+
+def _mat_variable(name: str, value, cols: dict, scalars: dict) -> None:
+    """Add a MATLAB variable: numeric arrays as channels/scalars, struct fields recursively."""
+    if isinstance(value, dict):  # struct (scipy simplify_cells, mat73): fields as a.b
+        for key, field_value in value.items():
+            _mat_variable(f"{name}.{key}", field_value, cols, scalars)
+        return
+    if value is None or isinstance(value, (str, bytes, list, tuple)):
+        return  # empty (mat73), char, cell array: not signals
+    arr = np.asarray(value)
+    if arr.dtype.kind not in "biuf" or arr.size == 0:
+        return  # text, cells, objects, complex, empty arrays: not signals
+    _split_2d(name, arr, cols, scalars)
+
+
+def _read_netcdf_table(p: Path) -> DataTable:
+    """A NetCDF file as measured data: every 1-D numeric variable (coordinates included, e.g.
+    ``time``) is a channel; numeric global attributes (e.g. ``fs``) are scalars."""
+    try:
+        import xarray as xr
+
+        ds = xr.open_dataset(p, engine="h5netcdf")
+    except Exception as exc:  # h5netcdf/h5py raise OSError, ValueError, KeyError...
+        raise DataFileError(p, f"not a readable NetCDF4/HDF5 file ({type(exc).__name__}: "
+                               f"{exc})") from exc
     cols: dict[str, np.ndarray] = {}
     scalars: dict[str, float] = {}
     try:
-        with h5py.File(p, "r") as f:
-            for name, obj in f.items():
-                if isinstance(obj, h5py.Dataset) and not name.startswith("#"):
-                    # MATLAB writes column-major: transpose back
-                    _split_2d(name, np.asarray(obj[()]).T, cols, scalars)
-    except OSError as exc:
-        raise DataFileError(p, f"not a readable MATLAB v7.3/HDF5 file ({exc})") from exc
+        for name, var in {**dict(ds.coords), **dict(ds.data_vars)}.items():
+            if var.ndim == 1 and var.dtype.kind in "biuf":
+                cols[str(name)] = np.asarray(var.values, dtype=np.float64)
+        for k, v in ds.attrs.items():
+            if isinstance(v, int | float | np.integer | np.floating) and not isinstance(v, bool):
+                scalars[str(k)] = float(v)
+    finally:
+        ds.close()
     if not cols:
-        raise DataFileError(p, "no numeric vector or matrix variables")
+        raise DataFileError(p, "no numeric 1-D variables")
     return DataTable(str(p), cols, scalars)
 
 
@@ -331,6 +407,12 @@ def read_simulation(path, variables) -> tuple[np.ndarray, dict[str, np.ndarray],
                                f"{exc})") from exc
     try:
         if "time" not in ds.coords and "time" not in ds.variables:
+            if "run_files" in ds.attrs:  # the results.nc of `geardyn run`: records are beside it
+                runs = p.parent / "runs"
+                raise DataFileError(p, "holds the study's tables, maps and diagnostics, not a "
+                                       "simulated record; the records are one file per run: "
+                                       f"diagnose {runs / 'model_II_cracked.nc'} (or another "
+                                       f"file in {runs})")
             raise DataFileError(p, "no 'time' coordinate: not a geardyn simulation result")
         missing = [v for v in variables if v not in ds.data_vars]
         if missing:

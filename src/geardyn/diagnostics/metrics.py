@@ -59,7 +59,7 @@ from scipy import fft as sfft
 from geardyn.errors import InputError
 
 from ..io import json_safe
-from .demodulation import band_limits
+from .demodulation import band_analytic_signal
 from .spectra import difference, mesh_orders, regular, residual
 from .tsa import DiagnosticsWarning, _as_float_array, _check_int
 
@@ -99,19 +99,26 @@ def _deviation_scaled(x: np.ndarray) -> tuple[np.ndarray, float]:
     return (d / s if s > 0 else d), s * big if big > 0 else s
 
 
-def _normalised_moment(x: np.ndarray, order: int, name: str) -> float:
+def _normalised_moment(x: np.ndarray, order: int, name: str, warn: bool = True) -> float:
     z, _ = _deviation_scaled(x)
     m2 = float(np.mean(z * z))
     if not m2 > 0:
-        warnings.warn(f"{name}: constant signal (zero variance); returning NaN",
-                      DiagnosticsWarning, stacklevel=3)
+        if warn:
+            warnings.warn(f"{name}: constant signal (zero variance); returning NaN",
+                          DiagnosticsWarning, stacklevel=3)
         return math.nan
     return float(np.mean(z**order)) / m2 ** (order / 2)
 
 
-def kurtosis(x) -> float:
-    """Pearson kurtosis :math:`m_4/m_2^2` [-] (Gaussian 3, sinusoid 1.5, square wave 1)."""
-    return _normalised_moment(_as_float_array(x, "x", min_size=2), 4, "kurtosis")
+def kurtosis(x, *, warn_constant: bool = True) -> float:
+    """Pearson kurtosis :math:`m_4/m_2^2` [-] (Gaussian 3, sinusoid 1.5, square wave 1).
+
+    The one kurtosis of geardyn (statistics, Table 3 kurtoses, sweeps). A constant record
+    gives NaN, with a :class:`DiagnosticsWarning` unless ``warn_constant=False`` (for callers
+    that report NaN themselves, e.g. the PM of a pure carrier).
+    """
+    return _normalised_moment(_as_float_array(x, "x", min_size=2), 4, "kurtosis",
+                              warn=warn_constant)
 
 
 @dataclass(frozen=True)
@@ -189,7 +196,7 @@ def signal_statistics(x) -> SignalStatistics:
     if m2z > 0:
         std = math.sqrt(m2z) * dmax * scale
         skew = float(np.mean(z**3)) / m2z**1.5
-        kurt = float(np.mean(z**4)) / m2z**2
+        kurt = kurtosis(xs, warn_constant=False)
         cf = 1.0 / math.sqrt(m2z)
     else:
         warnings.warn("signal_statistics: constant signal (zero variance); normalised "
@@ -366,13 +373,8 @@ def band_envelope(x, *, teeth: int, harmonic: int = 1, bandwidth: int | None = N
     ndarray
         Envelope (unit u).
     """
-    xa = _as_float_array(x, "x", min_size=8)
     b = (int(teeth) - 1) // 2 if bandwidth is None else bandwidth
-    lo, hi = band_limits(teeth, harmonic, max(1, b), xa.size)
-    spec = sfft.fft(xa)
-    band = np.zeros_like(spec)
-    band[lo: hi + 1] = 2.0 * spec[lo: hi + 1]
-    return np.abs(sfft.ifft(band))
+    return np.abs(band_analytic_signal(x, teeth=teeth, harmonic=harmonic, bandwidth=max(1, b)))
 
 
 def nb4(x, *, teeth: int, harmonic: int = 1, bandwidth: int | None = None,

@@ -27,7 +27,6 @@ tooth-mesh events of a 23-tooth pinion with about 89 samples per tooth), 5th mes
 from __future__ import annotations
 
 import json
-import math
 import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -250,6 +249,13 @@ def load_measurement(
             ang = np.unwrap(ang)
     else:
         col = table.get(tach, "tach")
+        if not tach_column_is_pulse_times and col.shape[0] != n:
+            # before any edge search: a length mismatch is not a threshold problem
+            first = next(iter(signals))
+            raise InputError("tach", f"channel {tach!r} has {col.shape[0]} samples",
+                             f"a sampled pulse train as long as the signal {first!r} "
+                             f"({n} samples), or a column of pulse times "
+                             "(tach_column_is_pulse_times, --tach-times)")
         if tach_column_is_pulse_times:
             tach_times = col[np.isfinite(col)]
         else:
@@ -269,8 +275,9 @@ def load_measurement(
 
 
 def load(path, **kwargs) -> Measurement:
-    """:func:`load_simulation` for NetCDF files (``.nc``...), else :func:`load_measurement`."""
-    if Path(path).suffix.lower() in NETCDF_SUFFIXES:
+    """:func:`load_simulation` for NetCDF files (``.nc``...), else :func:`load_measurement`
+    (also for a NetCDF file when a ``tach`` channel is named, as for measured data)."""
+    if Path(path).suffix.lower() in NETCDF_SUFFIXES and kwargs.get("tach") is None:
         return load_simulation(path, **kwargs)
     return load_measurement(path, **kwargs)
 
@@ -639,10 +646,10 @@ def diagnose(
             pwvd_tsa=pwvd(avg, window_length=pwvd_window_length, max_order=max_order),
             pwvd_residual=pwvd(res, window_length=pwvd_window_length, max_order=max_order),
             statistics=signal_statistics(avg),
-            residual_kurtosis=_kurt(res),
-            envelope_kurtosis=_kurt(dem.envelope),
-            am_kurtosis=_kurt(dem.am),
-            pm_kurtosis=_kurt(dem.pm),
+            residual_kurtosis=kurtosis(res, warn_constant=False),
+            envelope_kurtosis=kurtosis(dem.envelope, warn_constant=False),
+            am_kurtosis=kurtosis(dem.am, warn_constant=False),
+            pm_kurtosis=kurtosis(dem.pm, warn_constant=False),
             metrics=condition_metrics(avg, teeth=z, residual_preset=residual_preset),
         )
     return DiagnosisResult(
@@ -661,10 +668,6 @@ def diagnose(
                                       "crest_factor=max|x-mean|/std; crest_factor_rms=max|x|/rms",
         },
     )
-
-
-def _kurt(x: np.ndarray) -> float:
-    return kurtosis(x) if np.ptp(x) > 0 else math.nan
 
 
 def diagnose_file(
@@ -709,7 +712,10 @@ def diagnose_file(
     -------
     DiagnosisResult
     """
-    if Path(path).suffix.lower() in NETCDF_SUFFIXES:
+    # a NetCDF file is read as a geardyn simulation (exact angle theta_p) unless the shaft angle
+    # is given as for measured data (a tach or angle channel): then any NetCDF file of 1-D
+    # channels (e.g. written by geardyn measure or a DAQ) reads like a CSV, fs from its attribute
+    if Path(path).suffix.lower() in NETCDF_SUFFIXES and tach is None and angle is None:
         sig = None if signals is None else ([signals] if isinstance(signals, str)
                                             else [str(s) for s in signals])
         m = load_simulation(path, signals=sig)

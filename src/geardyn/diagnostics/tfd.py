@@ -48,6 +48,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy import fft as sfft
+from scipy.signal import hilbert
 
 from geardyn.errors import InputError
 
@@ -110,17 +111,12 @@ def analytic_signal(x, *, remove_mean: bool = True) -> np.ndarray:
     Returns
     -------
     ndarray of complex, shape (N,)
-        z, with ``z.real == x - mean(x)`` (unit u).
+        z, with ``z.real`` equal to ``x - mean(x)`` to rounding (unit u).
     """
     xa = _as_float_array(x, "x", min_size=2)
-    n = xa.shape[0]
-    spec = sfft.fft(xa)
-    h = np.zeros(n)
-    h[0] = 0.0 if remove_mean else 1.0
-    h[1:(n + 1) // 2] = 2.0
-    if n % 2 == 0:
-        h[n // 2] = 1.0
-    return sfft.ifft(spec * h)
+    # scipy.signal.hilbert applies exactly these weights (its documented FFT method); the mean
+    # is subtracted first, so Z_0 is zero to rounding
+    return hilbert(xa - xa.mean() if remove_mean else xa)
 
 
 def _odd_window(window, length: int, name: str) -> np.ndarray:

@@ -67,6 +67,19 @@ physical choices. It is decided once per step (the mesh force never changes ``p_
 
 Nonlinear load laws (quadratic, table, induction) add their remainder ``Q(v_{n+1})`` to the same
 loop, evaluated first at the predicted speed and iterated to ``rtol`` of the torque scale.
+
+Tooth errors (:mod:`geardyn.modifications`)
+-------------------------------------------
+When ``eip[EI_ACTIVE] == 1`` eq. 15 becomes ``p - e`` per pair: once per step, at the same angle
+as the stiffness (taken modulo the hunting period ``lcm(z1, z2) 2 pi / z1`` for the tooth
+numbers), :func:`_excite` finds the (up to three) pairs in contact, each pair's error ``e_j``
+(per-tooth tables of pitch, slope and form deviation interpolated in each gear's roll length,
+closed-form tip relief, once-per-rev runout) and its load share ``s_j`` from the map. Pairs with
+``p_free - e_j >= 0`` carry load; the mesh force is ``N = h (k f (p - e_bar) + q p')`` with
+``f`` the loaded pairs' share and ``e_bar`` their share-weighted error, so the Sherman-Morrison
+update keeps its form with ``k -> k f`` and ``p~ -> p~ - e_bar``. Runout also shifts the angle
+at which the map is read by ``-e_run / r_b1`` (the mesh phase). Without errors nothing of this
+runs and ``f = 1``, ``e_bar = 0`` leave every operation bit for bit as before.
 """
 
 from __future__ import annotations
@@ -79,7 +92,7 @@ import numpy as np
 from ..stiffness.map import lookup, lookup_reference
 
 __all__ = ["advance", "advance_python", "law_torque", "STATUS_TEXT", "N_STATE", "N_FP", "N_IP",
-           "N_REC", "N_FAIL"]
+           "N_REC", "N_FAIL", "N_EIP", "N_EFP", "no_excitation"]
 
 # float parameters
 FP_DT, FP_BETA, FP_GAMMA, FP_ALPHA, FP_QMB, FP_RSUM, FP_T1T2, FP_D0 = 0, 1, 2, 3, 4, 5, 6, 7
@@ -87,17 +100,28 @@ FP_TOL, FP_RTOL, FP_HSTEP, FP_PLIM, FP_YLIM, FP_SIGMA, FP_UNORM = 8, 9, 10, 11, 
 FP_IN_P0, FP_IN_P1, FP_IN_P2, FP_IN_WREF, FP_IN_TREF, FP_IN_SLOPE = 15, 16, 17, 18, 19, 20
 FP_OUT_P0, FP_OUT_P1, FP_OUT_P2, FP_OUT_WREF, FP_OUT_TREF, FP_OUT_SLOPE = 21, 22, 23, 24, 25, 26
 FP_TSCALE = 27
-N_FP = 28
+FP_RIP_AMP, FP_RIP_ORDER, FP_RIP_PHASE = 28, 29, 30  # input torque ripple (issue 14.3)
+FP_DRIVE_GAIN, FP_WREF = 31, 32  # speed-controlled drive following a speed profile
+N_FP = 33
 # integer parameters
 IP_MODEL, IP_EVAL, IP_MAXIT, IP_SEP, IP_INLAW, IP_OUTLAW, IP_IN_NL, IP_OUT_NL = range(8)
 N_IP = 8
 # state
 S_Z, S_V, S_A = 0, 6, 12
 S_N, S_K, S_H, S_DD, S_IT, S_RB, S_RA, S_QIN, S_QOUT = 18, 19, 20, 21, 22, 23, 24, 25, 26
-N_STATE = 27
+S_E, S_RIP = 27, 28
+N_STATE = 29
 # record columns
-R_Z, R_V, R_N, R_DD, R_K, R_H, R_IT, R_RB, R_RA = 0, 6, 12, 13, 14, 15, 16, 17, 18
-N_REC = 19
+R_Z, R_V, R_N, R_DD, R_K, R_H, R_IT, R_RB, R_RA, R_E = 0, 6, 12, 13, 14, 15, 16, 17, 18, 19
+N_REC = 20
+# tooth errors (geardyn.modifications): integer and float parameters
+EI_ACTIVE, EI_Z1, EI_Z2, EI_NR, EI_TABLE, EI_RUNOUT, EI_SHARES = range(7)
+N_EIP = 7
+EF_PITCH_S, EF_S_END, EF_PB, EF_RB1, EF_U2TIP, EF_HPER, EF_RATIO = range(7)
+EF_GEAR0 = 7  # then per gear (pinion, gear):
+EG_ULO, EG_DU, EG_RELIEF, EG_RSTART, EG_RINV, EG_RPOW, EG_RUNOUT, EG_RPHASE = range(8)
+EF_PER_GEAR = 8
+N_EFP = EF_GEAR0 + 2 * EF_PER_GEAR
 # failure information
 N_FAIL = 10
 FAIL_NAMES = ("time", "theta_p", "mesh_deflection", "y_p", "y_g", "centre_distance_change",
@@ -163,10 +187,187 @@ def _q_out(fp, ip, tw, tt, dz):
 
 
 @numba.njit(cache=True, nogil=True, fastmath=False)
+def _input_forcing(fp, n, sp_t, sp_w):
+    """Explicit input torque at step ``n`` [N m]: the ripple ``A sin(k theta_ref + phi)``
+    (``theta_ref = n w dt``) plus the speed-controlled drive's ``c (w_target(t) - w_ref)``
+    (``w_target`` piecewise linear in ``(sp_t, sp_w)``, constant beyond the ends)."""
+    out = 0.0
+    if fp[FP_RIP_AMP] != 0.0:
+        out += fp[FP_RIP_AMP] * math.sin(fp[FP_RIP_ORDER] * (n * fp[FP_HSTEP]) + fp[FP_RIP_PHASE])
+    if fp[FP_DRIVE_GAIN] != 0.0:
+        wt = law_torque(3, 0.0, 0.0, 0.0, sp_t, sp_w, n * fp[FP_DT])
+        out += fp[FP_DRIVE_GAIN] * (wt - fp[FP_WREF])
+    return out
+
+
+def no_excitation():
+    """Excitation arrays of perfect involutes (the kernel skips the tooth-error branch)."""
+    return (np.zeros(N_EIP, dtype=np.int64), np.zeros(N_EFP), np.zeros((1, 2)),
+            np.zeros((1, 2)), np.zeros((3, 1, 1)))
+
+
+@numba.njit(cache=True, nogil=True, fastmath=False)
+def _table_value(tab, row, u, ulo, du, nr):
+    """Linear interpolation of ``tab[row]`` on ``ulo + du * arange(nr)`` (constant beyond)."""
+    x = (u - ulo) / du
+    if x <= 0.0:
+        return tab[row, 0]
+    if x >= nr - 1:
+        return tab[row, nr - 1]
+    k = int(math.floor(x))
+    if k > nr - 2:
+        k = nr - 2
+    t = x - k
+    return tab[row, k] * (1.0 - t) + tab[row, k + 1] * t
+
+
+@numba.njit(cache=True, nogil=True, fastmath=False)
+def _relief(efp, base, u):
+    """Tip relief ``C_a x^k`` of one gear at roll length ``u`` [m]."""
+    c = efp[base + EG_RELIEF]
+    if c <= 0.0:
+        return 0.0
+    x = (u - efp[base + EG_RSTART]) * efp[base + EG_RINV]
+    if x <= 0.0:
+        return 0.0
+    if efp[base + EG_RPOW] == 1.0:
+        return c * x
+    return c * x * x
+
+
+@numba.njit(cache=True, nogil=True, fastmath=False)
+def _lookup4(theta, dd, dd0, ddd, phase_a, length_a, mesh_angle, n_cycles, n_seg, kvals, els):
+    """``k_mb`` and the three load shares at ``(theta, dd)`` with the cell found once: the
+    arithmetic of :func:`geardyn.stiffness.map.lookup` (NaN outside the ``dd`` range)."""
+    n_d = kvals.shape[0]
+    if n_d == 1:
+        i = 0
+        w = 0.0
+    else:
+        x = (dd - dd0) / ddd
+        if x < -1e-9 or x > (n_d - 1) + 1e-9:
+            return np.nan, 0.0, 0.0, 0.0
+        i = int(math.floor(x))
+        if i < 0:
+            i = 0
+        if i > n_d - 2:
+            i = n_d - 2
+        w = x - i
+        if w < 0.0:
+            w = 0.0
+        if w > 1.0:
+            w = 1.0
+    i2 = i + 1 if n_d > 1 else 0
+    a = phase_a[i] + w * (phase_a[i2] - phase_a[i])
+    la = length_a[i] + w * (length_a[i2] - length_a[i])
+    period = n_cycles * mesh_angle
+    r = (theta - a) % period
+    c = int(math.floor(r / mesh_angle))
+    if c >= n_cycles:
+        c = n_cycles - 1
+    r -= c * mesh_angle
+    if la > 1e-12 * mesh_angle and r < la:
+        zone = 0
+        f = r / la
+    else:
+        zone = 1
+        lb = mesh_angle - la
+        f = (r - la) / lb if lb > 1e-12 * mesh_angle else 0.0
+        if f < 0.0:
+            f = 0.0
+    if f > 1.0:
+        f = 1.0
+    u = f * (n_seg - 1)
+    jn = int(math.floor(u))
+    if jn > n_seg - 2:
+        jn = n_seg - 2
+    t = u - jn
+    base = (2 * c + zone) * n_seg + jn
+    k = kvals[i, base] * (1.0 - t) + kvals[i, base + 1] * t
+    s0 = els[0, i, base] * (1.0 - t) + els[0, i, base + 1] * t
+    s1 = els[1, i, base] * (1.0 - t) + els[1, i, base + 1] * t
+    s2 = els[2, i, base] * (1.0 - t) + els[2, i, base + 1] * t
+    if n_d > 1:
+        k = k * (1.0 - w) + (kvals[i2, base] * (1.0 - t) + kvals[i2, base + 1] * t) * w
+        s0 = s0 * (1.0 - w) + (els[0, i2, base] * (1.0 - t) + els[0, i2, base + 1] * t) * w
+        s1 = s1 * (1.0 - w) + (els[1, i2, base] * (1.0 - t) + els[1, i2, base + 1] * t) * w
+        s2 = s2 * (1.0 - w) + (els[2, i2, base] * (1.0 - t) + els[2, i2, base + 1] * t) * w
+    return k, s0, s1, s2
+
+
+@numba.njit(cache=True, nogil=True, fastmath=False)
+def _excite(th, tha, b1, rsum, dd, pfree, sep, eip, efp, etp, etg, els,
+            dd0, ddd, phase_a, length_a, mesh_angle, n_cycles, n_seg, kvals):
+    """Tooth errors of the step (see :mod:`geardyn.modifications`).
+
+    ``th`` map angle, ``tha`` the same angle modulo the hunting period [rad], ``b1`` the
+    centre distance, ``dd`` its change [m], ``pfree`` the free mesh deflection [m].
+
+    Returns ``(th_k, e_bar, frac, h, k)``: the angle of the contact pattern (runout shifts it),
+    the share-weighted error of the loaded pairs [m], their share of ``k_mb``, the contact flag
+    and ``k_mb(th_k, dd)`` [N/m] (NaN when the map has no load shares or ``dd`` is off the map:
+    the caller then looks it up itself).
+    """
+    rb1 = efp[EF_RB1]
+    run = 0.0
+    if eip[EI_RUNOUT] == 1:
+        bp = EF_GEAR0
+        bg = EF_GEAR0 + EF_PER_GEAR
+        run = efp[bp + EG_RUNOUT] * math.sin(tha + efp[bp + EG_RPHASE]) \
+            + efp[bg + EG_RUNOUT] * math.sin(tha * efp[EF_RATIO] + efp[bg + EG_RPHASE])
+    th_k = th - run / rb1
+    tha_e = tha - run / rb1
+    t1t2 = math.sqrt(b1 * b1 - rsum * rsum)
+    s_start = t1t2 - efp[EF_U2TIP]
+    pb = efp[EF_PB]
+    s_th = efp[EF_PITCH_S] + rb1 * tha_e
+    n_exit = int(math.floor((s_th - efp[EF_S_END]) / pb))
+    z1 = eip[EI_Z1]
+    z2 = eip[EI_Z2]
+    nr = eip[EI_NR]
+    bp = EF_GEAR0
+    bg = EF_GEAR0 + EF_PER_GEAR
+    tot = 0.0
+    sa = 0.0
+    se = 0.0
+    cnt = 0
+    nact = 0
+    sh0 = sh1 = sh2 = 1.0
+    kk = np.nan
+    if eip[EI_SHARES] == 1:
+        kk, sh0, sh1, sh2 = _lookup4(th_k, dd, dd0, ddd, phase_a, length_a, mesh_angle,
+                                     n_cycles, n_seg, kvals, els)
+    for k in range(3):
+        nk = n_exit + 1 + k
+        s = s_th - nk * pb
+        if s < s_start - 1e-12:
+            continue
+        cnt += 1
+        ek = run + _relief(efp, bp, s) + _relief(efp, bg, t1t2 - s)
+        if eip[EI_TABLE] == 1:
+            ek += _table_value(etp, nk % z1, s, efp[bp + EG_ULO], efp[bp + EG_DU], nr) \
+                + _table_value(etg, nk % z2, t1t2 - s, efp[bg + EG_ULO], efp[bg + EG_DU], nr)
+        sh = sh0 if k == 0 else (sh1 if k == 1 else sh2)
+        tot += sh
+        if (not sep) or pfree - ek >= 0.0:
+            nact += 1
+            sa += sh
+            se += sh * ek
+    if cnt == 0:
+        return th_k, run, 1.0, 1.0, kk
+    if nact == 0:
+        return th_k, 0.0, 1.0, 0.0, kk
+    if sa <= 0.0:  # only pairs the map gives no share (a handover node): no error weighting
+        return th_k, run, 1.0, 1.0, kk
+    frac = 1.0 if nact == cnt else sa / tot
+    return th_k, se / sa, frac, 1.0, kk
+
+
+@numba.njit(cache=True, nogil=True, fastmath=False)
 def advance(n_steps, rec_start, decim, out, j, st, ist, fail,
             M, K0, C, Q0, Sinv, SK, SC, sQ, u, g, fp, ip,
             dd0, ddd, phase_a, length_a, mesh_angle, n_cycles, n_seg, kvals,
-            in_w, in_t, out_w, out_t):
+            in_w, in_t, out_w, out_t, eip, efp, etp, etg, els, sp_t, sp_w):
     """Advance the state ``st`` (step count ``ist[0]``) by up to ``n_steps`` steps.
 
     Writes a record row into ``out[j]`` after every step ``n >= rec_start`` with
@@ -206,6 +407,10 @@ def advance(n_steps, rec_start, decim, out, j, st, ist, fail,
     bdt2 = beta * dt * dt
     gdt = gam * dt
     period = n_cycles * mesh_angle
+    eact = eip[EI_ACTIVE] == 1
+    hper = efp[EF_HPER]
+    rip = fp[FP_RIP_AMP] != 0.0 or fp[FP_DRIVE_GAIN] != 0.0
+    dtr = 0.0
 
     xt = np.empty(6)
     vt = np.empty(6)
@@ -240,9 +445,15 @@ def advance(n_steps, rec_start, decim, out, j, st, ist, fail,
         if in_nl or out_nl:
             for i in range(6):
                 w[i] += opa * (Sinv[i, 0] * qin + Sinv[i, 5] * qout)
+        if rip:  # input torque ripple and drive at t_{n+1} (see _input_forcing)
+            dtr = _input_forcing(fp, n + 1, sp_t, sp_w)
+            for i in range(6):
+                w[i] += opa * Sinv[i, 0] * dtr
         if al != 0.0:
             for i in range(6):
                 acc = -sQ[i] + st[S_N] * u[i] - Sinv[i, 0] * st[S_QIN] - Sinv[i, 5] * st[S_QOUT]
+                if rip:
+                    acc -= Sinv[i, 0] * st[S_RIP]
                 for k in range(6):
                     acc += SC[i, k] * st[S_V + k] + SK[i, k] * st[S_Z + k]
                 w[i] += al * acc
@@ -272,6 +483,21 @@ def advance(n_steps, rec_start, decim, out, j, st, ist, fail,
             b1 = math.sqrt(rsum * rsum + e * e)
         else:
             b1 = d0
+        # ---- tooth errors: e_bar, the loaded pairs' share and the pattern's angle
+        th_k = th
+        ebar = 0.0
+        frac = 1.0
+        k_pre = np.nan
+        if eact:
+            if ev_start:
+                tha = np.fmod(n * hstep, hper) + st[S_Z + 2]
+            else:
+                tha = np.fmod((n + 1) * hstep, hper) + st[S_Z + 2] + dt * st[S_V + 2] \
+                    + 0.5 * dt * dt * st[S_A + 2]
+            th_k, ebar, frac, hh, k_pre = _excite(th, tha, b1, rsum, b1 - d0, pt + bdt2 * gw,
+                                                  sep, eip, efp, etp, etg, els, dd0, ddd,
+                                                  phase_a, length_a, mesh_angle, n_cycles, n_seg,
+                                                  kvals)
         it = 0
         res_b = np.nan
         res = np.nan
@@ -285,16 +511,20 @@ def advance(n_steps, rec_start, decim, out, j, st, ist, fail,
         take_next = False
         status = OK
         while True:
-            kk = lookup(th, b1 - d0, dd0, ddd, phase_a, length_a, mesh_angle, n_cycles, n_seg,
-                        kvals)
+            if it == 0 and k_pre == k_pre:  # found with the load shares at the same point
+                kk = k_pre
+            else:
+                kk = lookup(th_k, b1 - d0, dd0, ddd, phase_a, length_a, mesh_angle, n_cycles,
+                            n_seg, kvals)
             if kk != kk:
                 status = MAP_RANGE
                 break
             if it == 0:
                 k_first = kk
+            keff = kk * frac
             if hh > 0.0:
-                c = bdt2 * kk + gdt * q
-                nf = (kk * pt + q * pdt + c * gw) / (1.0 + opa * c * sigma)
+                c = bdt2 * keff + gdt * q
+                nf = (keff * (pt - ebar) + q * pdt + c * gw) / (1.0 + opa * c * sigma)
             else:
                 nf = 0.0
             for i in range(6):
@@ -366,8 +596,10 @@ def advance(n_steps, rec_start, decim, out, j, st, ist, fail,
             st[S_V + i] = vt[i] + gdt * an[i]
             st[S_A + i] = an[i]
         st[S_N] = nf
-        st[S_K] = kk
+        st[S_K] = kk * frac
         st[S_H] = hh
+        st[S_E] = ebar
+        st[S_RIP] = dtr
         st[S_DD] = b2 - d0
         st[S_IT] = it
         st[S_RB] = res_b
@@ -415,6 +647,7 @@ def _write(out, j, st):
     out[j, R_IT] = st[S_IT]
     out[j, R_RB] = st[S_RB]
     out[j, R_RA] = st[S_RA]
+    out[j, R_E] = st[S_E]
 
 
 @numba.njit(cache=True, nogil=True, fastmath=False)
@@ -445,10 +678,61 @@ def _law_torque_py(code, p0, p1, p2, tw, tt, w):
     return 2.0 * p1 * s * p2 / (s * s + p2 * p2)
 
 
+def _excite_py(th, tha, b1, rsum, dd, pfree, sep, eip, efp, etp, etg, els, arrays):
+    """NumPy twin of :func:`_excite` (``numpy.interp`` tables, ``lookup_reference`` shares)."""
+    from ..stiffness.map import lookup_reference
+
+    rb1, pb = efp[EF_RB1], efp[EF_PB]
+    gears = (EF_GEAR0, EF_GEAR0 + EF_PER_GEAR)
+    run = 0.0
+    if eip[EI_RUNOUT] == 1:
+        run = sum(efp[b + EG_RUNOUT] * math.sin(a + efp[b + EG_RPHASE])
+                  for b, a in zip(gears, (tha, tha * efp[EF_RATIO]), strict=True))
+    th_k, tha_e = th - run / rb1, tha - run / rb1
+    t1t2 = math.sqrt(b1 * b1 - rsum * rsum)
+    s_th = efp[EF_PITCH_S] + rb1 * tha_e
+    n_exit = math.floor((s_th - efp[EF_S_END]) / pb)
+
+    def relief(b, uu):
+        c = efp[b + EG_RELIEF]
+        x = (uu - efp[b + EG_RSTART]) * efp[b + EG_RINV]
+        return c * x ** efp[b + EG_RPOW] if c > 0 and x > 0 else 0.0
+
+    def table(tab, row, b, uu):
+        grid = efp[b + EG_ULO] + efp[b + EG_DU] * np.arange(eip[EI_NR])
+        return float(np.interp(uu, grid, tab[row]))
+
+    rows = []
+    for k in range(3):
+        nk = n_exit + 1 + k
+        s = s_th - nk * pb
+        if s < t1t2 - efp[EF_U2TIP] - 1e-12:
+            continue
+        ek = run + relief(gears[0], s) + relief(gears[1], t1t2 - s)
+        if eip[EI_TABLE] == 1:
+            ek += table(etp, nk % eip[EI_Z1], gears[0], s) \
+                + table(etg, nk % eip[EI_Z2], gears[1], t1t2 - s)
+        sh = 1.0
+        if eip[EI_SHARES] == 1:
+            sh = float(lookup_reference(np.array(th_k), np.array(dd),
+                                        arrays._replace(values=els[k])))
+        rows.append((ek, sh, (not sep) or pfree - ek >= 0.0))
+    if not rows:
+        return th_k, run, 1.0, 1.0
+    act = [(e, sh) for e, sh, a in rows if a]
+    if not act:
+        return th_k, 0.0, 1.0, 0.0
+    sa = sum(sh for _, sh in act)
+    if sa <= 0.0:
+        return th_k, run, 1.0, 1.0
+    frac = 1.0 if len(act) == len(rows) else sa / sum(sh for _, sh, _ in rows)
+    return th_k, sum(e * sh for e, sh in act) / sa, frac, 1.0
+
+
 def advance_python(n_steps, rec_start, decim, out, j, st, ist, fail,
                    M, K0, C, Q0, Sinv, SK, SC, sQ, u, g, fp, ip,
                    dd0, ddd, phase_a, length_a, mesh_angle, n_cycles, n_seg, kvals,
-                   in_w, in_t, out_w, out_t):
+                   in_w, in_t, out_w, out_t, eip, efp, etp, etg, els, sp_t, sp_w):
     """Pure-Python/NumPy twin of :func:`advance` (same arguments and results).
 
     Written separately: it assembles the full effective matrix
@@ -486,8 +770,8 @@ def advance_python(n_steps, rec_start, decim, out, j, st, ist, fail,
     def write(jj):
         out[jj, R_Z:R_Z + 6] = st[S_Z:S_Z + 6]
         out[jj, R_V:R_V + 6] = st[S_V:S_V + 6]
-        out[jj, [R_N, R_DD, R_K, R_H, R_IT, R_RB, R_RA]] = st[[S_N, S_DD, S_K, S_H, S_IT, S_RB,
-                                                               S_RA]]
+        out[jj, [R_N, R_DD, R_K, R_H, R_IT, R_RB, R_RA, R_E]] = st[[S_N, S_DD, S_K, S_H, S_IT,
+                                                                    S_RB, S_RA, S_E]]
 
     n = int(ist[0])
     if ist[1] == 0 and n >= rec_start and (n - rec_start) % decim == 0 and j < out.shape[0]:
@@ -499,6 +783,14 @@ def advance_python(n_steps, rec_start, decim, out, j, st, ist, fail,
         xt = z + dt * v + dt * dt * (0.5 - beta) * a
         vt = v + dt * (1 - gam) * a
         load = Q0.copy()
+        rip1 = 0.0
+        if fp[FP_RIP_AMP] != 0.0:
+            rip1 = fp[FP_RIP_AMP] * math.sin(fp[FP_RIP_ORDER] * ((n + 1) * hstep)
+                                             + fp[FP_RIP_PHASE])
+        if fp[FP_DRIVE_GAIN] != 0.0:
+            rip1 += fp[FP_DRIVE_GAIN] * (float(np.interp((n + 1) * dt, sp_t, sp_w))
+                                         - fp[FP_WREF])
+        load[0] += rip1
         if in_nl:
             load[0] += q_in(v[0] + dt * a[0])
         if out_nl:
@@ -506,7 +798,7 @@ def advance_python(n_steps, rec_start, decim, out, j, st, ist, fail,
         old = np.zeros(6)
         if al != 0.0:
             old = C @ v + K0 @ z - Q0 + st[S_N] * g
-            old[0] -= st[S_QIN]
+            old[0] -= st[S_QIN] + st[S_RIP]
             old[5] -= st[S_QOUT]
         # free solve decides the contact state
         a_free = np.linalg.solve(S, opa * (load - C @ vt - K0 @ xt) + al * old)
@@ -519,22 +811,30 @@ def advance_python(n_steps, rec_start, decim, out, j, st, ist, fail,
             ype = z[1] + dt * v[1] + 0.5 * dt * dt * a[1]
             yge = z[3] + dt * v[3] + 0.5 * dt * dt * a[3]
         b1 = math.hypot(rsum, t1t2 + yge - ype) if model2 else d0
+        th_k, ebar, frac = th, 0.0, 1.0
+        if eip[EI_ACTIVE] == 1:
+            nn = n if ev_start else n + 1
+            zth = z[2] if ev_start else z[2] + dt * v[2] + 0.5 * dt * dt * a[2]
+            tha = np.fmod(nn * hstep, efp[EF_HPER]) + zth
+            th_k, ebar, frac, hh = _excite_py(th, tha, b1, rsum, b1 - d0,
+                                              g @ (xt + beta * dt * dt * a_free), sep, eip, efp,
+                                              etp, etg, els, arrays)
         it, res_b, res, a_prev = 0, np.nan, np.nan, None
         history_b2, history_k, take_next = [], [], False
         status = OK
         while True:
-            kk = float(lookup_reference(np.array(th), np.array(b1 - d0), arrays))
+            kk = float(lookup_reference(np.array(th_k), np.array(b1 - d0), arrays))
             if np.isnan(kk):
                 status = MAP_RANGE
                 nf = 0.0
                 break
-            K = K0 + hh * kk * gg
+            K = K0 + hh * kk * frac * gg
             Ct = C + hh * q * gg
             Seff = M + opa * (gam * dt * Ct + beta * dt * dt * K)
-            rhs = opa * (load - Ct @ vt - K @ xt) + al * old
+            rhs = opa * (load - Ct @ vt - K @ xt + hh * kk * frac * ebar * g) + al * old
             an = np.linalg.solve(Seff, rhs)
             zn, vn = xt + beta * dt * dt * an, vt + gam * dt * an
-            nf = hh * (kk * (g @ zn) + q * (g @ vn))
+            nf = hh * (kk * frac * (g @ zn - ebar) + q * (g @ vn))
             b2 = math.hypot(rsum, t1t2 + zn[3] - zn[1])
             conv = True
             if model2:
@@ -548,7 +848,7 @@ def advance_python(n_steps, rec_start, decim, out, j, st, ist, fail,
                 if da > rtol * rtol * sc:
                     conv = False
             if in_nl or out_nl:
-                dq0 = q_in(vn[0]) - (load[0] - Q0[0]) if in_nl else 0.0
+                dq0 = q_in(vn[0]) - (load[0] - Q0[0] - rip1) if in_nl else 0.0
                 dq5 = q_out(vn[5]) - (load[5] - Q0[5]) if out_nl else 0.0
                 if max(abs(dq0), abs(dq5)) > rtol * fp[FP_TSCALE]:
                     conv = False
@@ -577,8 +877,8 @@ def advance_python(n_steps, rec_start, decim, out, j, st, ist, fail,
             fail[:] = [(n + 1) * dt, th, g @ xt, xt[1], xt[3], b1 - d0, nf, kk, it, res]
             return status, j
         st[S_Z:S_Z + 6], st[S_V:S_V + 6], st[S_A:S_A + 6] = zn, vn, an
-        st[S_N], st[S_K], st[S_H], st[S_DD] = nf, kk, hh, b2 - d0
-        st[S_IT], st[S_RB], st[S_RA] = it, res_b, res
+        st[S_N], st[S_K], st[S_H], st[S_DD] = nf, kk * frac, hh, b2 - d0
+        st[S_IT], st[S_RB], st[S_RA], st[S_E], st[S_RIP] = it, res_b, res, ebar, rip1
         if in_nl:
             st[S_QIN] = q_in(vn[0])
         if out_nl:

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -66,6 +66,11 @@ class KernelSetup:
     map_arrays: MapArrays
     in_table: tuple[np.ndarray, np.ndarray]
     out_table: tuple[np.ndarray, np.ndarray]
+    #: tooth-error arrays ``(eip, efp, table_pinion, table_gear, shares)``
+    #: (:meth:`geardyn.modifications.ToothModifications.kernel_arrays`); default: none
+    excitation: tuple = field(default_factory=K.no_excitation)
+    #: target speed profile ``(times [s], speeds [rad/s])`` of a speed-controlled drive
+    speed_profile: tuple = field(default_factory=lambda: (np.array([0.0, 1.0]), np.zeros(2)))
 
     def args(self) -> tuple:
         """The kernel arguments after ``fail``."""
@@ -73,7 +78,8 @@ class KernelSetup:
         return (self.M, self.K0, self.C, self.Q0, self.Sinv, self.SK, self.SC, self.sQ, self.u,
                 self.g, self.fp, self.ip,
                 m.dd0, m.ddd, m.phase_a, m.length_a, m.mesh_angle, m.n_cycles, m.n_seg, m.values,
-                self.in_table[0], self.in_table[1], self.out_table[0], self.out_table[1])
+                self.in_table[0], self.in_table[1], self.out_table[0], self.out_table[1],
+                *self.excitation, *self.speed_profile)
 
     @property
     def dt(self) -> float:
@@ -88,7 +94,10 @@ def make_setup(M, K0, C, g, Q0, stiffness_map: StiffnessMap | MapArrays, *, dt: 
                max_iterations: int = 50, speed: float = 0.0, p_lim: float = math.inf,
                y_lim: float = math.inf, separation: bool = True,
                input_law: TorqueLaw | None = None, output_law: TorqueLaw | None = None,
-               input_speed: float = 0.0, output_speed: float = 0.0) -> KernelSetup:
+               input_speed: float = 0.0, output_speed: float = 0.0,
+               excitation: tuple | None = None,
+               ripple: tuple[float, float, float] = (0.0, 1.0, 0.0),
+               drive: tuple | None = None) -> KernelSetup:
     r"""Arrays for the kernel from a general 6-DOF system in deviation coordinates.
 
     The system is ``M z'' + C z' + K0 z + N g = Q0 + q(z')``, ``N = h (k p + q_mb p')``,
@@ -130,6 +139,17 @@ def make_setup(M, K0, C, g, Q0, stiffness_map: StiffnessMap | MapArrays, *, dt: 
         constant is in ``Q0`` and their slope in ``C``).
     input_speed, output_speed : float
         Reference speeds of DOF 0 and 5 [rad/s] (the laws are linearised there).
+    excitation : tuple, optional
+        Tooth-error arrays from :meth:`geardyn.modifications.ToothModifications.kernel_arrays`
+        (the mesh force becomes ``h (k f (p - e_bar) + q_mb p')``); default none.
+    ripple : (float, float, float)
+        Input torque ripple ``A sin(n theta_ref + phi)`` added to DOF 0: amplitude ``A`` [N m],
+        order ``n`` [-] and phase ``phi`` [rad], locked to the reference angle
+        ``theta_ref = speed t`` (0 amplitude: none).
+    drive : (gain, w_ref, times, speeds), optional
+        Speed-controlled drive: adds ``gain (w_target(t) - w_ref)`` [N m] to DOF 0, with
+        ``w_target`` piecewise linear in ``(times [s], speeds [rad/s])``; the drive's slope
+        ``-gain`` must already be in ``C[0, 0]``.
     """
     if model not in ("I", "II"):
         raise InputError("simulation.model", model, "'I' or 'II'")
@@ -163,6 +183,12 @@ def make_setup(M, K0, C, g, Q0, stiffness_map: StiffnessMap | MapArrays, *, dt: 
     fp[K.FP_IN_P0:K.FP_IN_SLOPE + 1] = laws[0][1]
     fp[K.FP_OUT_P0:K.FP_OUT_SLOPE + 1] = laws[1][1]
     fp[K.FP_TSCALE] = max(abs(laws[0][1][4]), abs(laws[1][1][4]), 1e-300)
+    fp[K.FP_RIP_AMP], fp[K.FP_RIP_ORDER], fp[K.FP_RIP_PHASE] = ripple
+    profile = (np.array([0.0, 1.0]), np.zeros(2))
+    if drive is not None:
+        fp[K.FP_DRIVE_GAIN], fp[K.FP_WREF] = drive[0], drive[1]
+        profile = (np.ascontiguousarray(drive[2], dtype=float),
+                   np.ascontiguousarray(drive[3], dtype=float))
     ip = np.zeros(K.N_IP, dtype=np.int64)
     ip[K.IP_MODEL] = 2 if model == "II" else 1
     ip[K.IP_EVAL] = 1 if evaluation == "start" else 0
@@ -173,7 +199,9 @@ def make_setup(M, K0, C, g, Q0, stiffness_map: StiffnessMap | MapArrays, *, dt: 
     return KernelSetup(M=M, K0=K0, C=C, Q0=Q0, Sinv=Sinv, SK=np.ascontiguousarray(Sinv @ K0),
                        SC=np.ascontiguousarray(Sinv @ C), sQ=np.ascontiguousarray(Sinv @ Q0),
                        u=np.ascontiguousarray(u), g=g, fp=fp, ip=ip, map_arrays=arrays,
-                       in_table=laws[0][0].table(), out_table=laws[1][0].table())
+                       in_table=laws[0][0].table(), out_table=laws[1][0].table(),
+                       excitation=K.no_excitation() if excitation is None else excitation,
+                       speed_profile=profile)
 
 
 def _q_remainders(setup: KernelSetup, v: np.ndarray) -> tuple[float, float]:
@@ -212,24 +240,37 @@ def initial_state(setup: KernelSetup, z0, v0=None, step: int = 0) -> tuple[np.nd
     d = math.hypot(fp[K.FP_RSUM], fp[K.FP_T1T2] + z0[3] - z0[1])
     dd = d - fp[K.FP_D0] if ip[K.IP_MODEL] == 2 else 0.0
     theta = np.fmod(step * fp[K.FP_HSTEP], period) + z0[2]
-    k0 = float(lookup_reference(np.array(theta), np.array(dd), m))
+    p0, pd0 = g @ z0, g @ v0
+    th_k, ebar, frac, h_err = theta, 0.0, 1.0, None
+    eip, efp, etp, etg, els = setup.excitation
+    if eip[K.EI_ACTIVE] == 1:  # tooth errors (geardyn.modifications)
+        tha = np.fmod(step * fp[K.FP_HSTEP], efp[K.EF_HPER]) + z0[2]
+        th_k, ebar, frac, h_err = K._excite_py(theta, tha, d if ip[K.IP_MODEL] == 2 else
+                                               fp[K.FP_D0], fp[K.FP_RSUM], dd, p0,
+                                               bool(ip[K.IP_SEP]), eip, efp, etp, etg, els, m)
+    k0 = float(lookup_reference(np.array(th_k), np.array(dd), m))
     if np.isnan(k0):
         raise InputError("stiffness_map", f"range [{m.dd0:.6g}, "
                          f"{m.dd0 + m.ddd * (m.values.shape[0] - 1):.6g}] m",
                          f"a map covering the initial centre distance change {dd:.6g} m")
-    p0, pd0 = g @ z0, g @ v0
     h0 = 0.0 if (ip[K.IP_SEP] and p0 < 0) else 1.0
-    n0 = h0 * (k0 * p0 + fp[K.FP_QMB] * pd0)
+    if h_err is not None:
+        h0, k0 = h_err, k0 * frac
+    n0 = h0 * (k0 * (p0 - ebar) + fp[K.FP_QMB] * pd0)
     qin, qout = _q_remainders(setup, v0)
     f = setup.Q0 - setup.C @ v0 - setup.K0 @ z0 - n0 * g
     f[0] += qin
     f[5] += qout
+    rip = 0.0
+    if fp[K.FP_RIP_AMP] != 0.0 or fp[K.FP_DRIVE_GAIN] != 0.0:  # ripple and drive at this step
+        rip = float(K._input_forcing(fp, step, *setup.speed_profile))
+        f[0] += rip
     a0 = np.linalg.solve(setup.M, f)
     st = np.zeros(K.N_STATE)
     st[K.S_Z:K.S_Z + 6], st[K.S_V:K.S_V + 6], st[K.S_A:K.S_A + 6] = z0, v0, a0
     st[K.S_N], st[K.S_K], st[K.S_H], st[K.S_DD] = n0, k0, h0, d - fp[K.FP_D0]
     st[K.S_IT], st[K.S_RB], st[K.S_RA] = 0.0, np.nan, np.nan
-    st[K.S_QIN], st[K.S_QOUT] = qin, qout
+    st[K.S_QIN], st[K.S_QOUT], st[K.S_E], st[K.S_RIP] = qin, qout, ebar, rip
     return st, np.array([step, 0], dtype=np.int64)
 
 
@@ -259,11 +300,17 @@ def _setup_for_case(case, dyn: DynamicModel, stiffness_map: StiffnessMap, which:
     Q0, d_in, d_out = dyn.forcing_at_reference()
     C = dyn.C0.copy()
     C[0, 0] += d_in
+    drive = _speed_profile(case, dyn)
+    if drive is not None:
+        C[0, 0] += drive[0]  # the drive's torque falls with the motor speed
     C[5, 5] += d_out
     pair = dyn.pair
     m_n = pair.module
     p_lim = max(50.0 * abs(static.mesh_deflection), 0.1 * m_n)
     y_lim = max(20.0 * max(abs(static.y_p), abs(static.y_g)), m_n)
+    from ..modifications import ToothModifications
+
+    mods = ToothModifications.from_case(case)
     return make_setup(
         dyn.M, dyn.K0, C, dyn.g, Q0, stiffness_map, dt=sim.dt, model=which,
         evaluation=sim.stiffness_evaluation, integrator=sim.integrator, hht_alpha=sim.hht_alpha,
@@ -271,7 +318,59 @@ def _setup_for_case(case, dyn: DynamicModel, stiffness_map: StiffnessMap, which:
         d0=pair.design_centre_distance, tolerance=sim.tolerance, rtol=sim.rtol,
         max_iterations=sim.max_iterations, speed=dyn.speed, p_lim=p_lim, y_lim=y_lim,
         separation=True, input_law=dyn.input_law, output_law=dyn.output_law,
-        input_speed=dyn.speed, output_speed=dyn.gear_speed)
+        input_speed=dyn.speed, output_speed=dyn.gear_speed,
+        excitation=mods.kernel_arrays(stiffness_map) if mods.active else None,
+        ripple=(case.motor.ripple * float(dyn.input_law.torque(dyn.speed)),
+                case.motor.ripple_order, case.motor.ripple_phase),
+        drive=drive)
+
+
+def _speed_profile(case, dyn: DynamicModel):
+    """``(gain, w_ref, times, speeds)`` of the case's speed-controlled drive, or None.
+
+    Raises
+    ------
+    InputError
+        Profile lists of different lengths, fewer than 2 points, times not increasing, speeds
+        not positive.
+    """
+    m = case.motor
+    t, w = m.profile_times, m.profile_speeds
+    if t is None and w is None:
+        return None
+    t = np.asarray(t if t is not None else [], float)
+    w = np.asarray(w if w is not None else [], float)
+    if t.size < 2 or t.size != w.size:
+        raise InputError("motor.profile_times", f"{t.size} times and {w.size} speeds",
+                         "two lists of the same length >= 2 (profile_times [s], "
+                         "profile_speeds [rad/s])")
+    if not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0):
+        raise InputError("motor.profile_times", t.tolist(), "strictly increasing finite times [s]")
+    if not np.all(np.isfinite(w)) or np.any(w <= 0):
+        raise InputError("motor.profile_speeds", w.tolist(), "finite target speeds > 0 [rad/s]")
+    return float(m.drive_gain), float(dyn.speed), t, w
+
+
+def _start_with_errors(setup: KernelSetup, dyn: DynamicModel, static: StaticState) -> np.ndarray:
+    """The static start ``z`` with tooth errors: the gear (and load) turned back so that the mesh
+    deflection is ``N / (k f) + e_bar`` at ``t = 0`` with every pair loaded."""
+    from ..stiffness.map import lookup_reference
+
+    z = static.z.copy()
+    eip, efp, etp, etg, els = setup.excitation
+    if eip[K.EI_ACTIVE] != 1:
+        return z
+    fp, m = setup.fp, setup.map_arrays
+    model2 = setup.ip[K.IP_MODEL] == 2
+    d = math.hypot(fp[K.FP_RSUM], fp[K.FP_T1T2] + z[3] - z[1])
+    dd = d - fp[K.FP_D0] if model2 else 0.0
+    th_k, ebar, frac, _ = K._excite_py(z[2], z[2], d if model2 else fp[K.FP_D0], fp[K.FP_RSUM],
+                                       dd, math.inf, False, eip, efp, etp, etg, els, m)
+    k = float(lookup_reference(np.array(th_k), np.array(dd), m)) * frac
+    shift = (setup.g @ z - (static.mesh_force / k + ebar)) / dyn.r_b2
+    z[4] += shift
+    z[5] += shift
+    return z
 
 
 def simulate(case, stiffness_map: StiffnessMap | None = None, *, model: str | None = None,
@@ -317,6 +416,7 @@ def simulate(case, stiffness_map: StiffnessMap | None = None, *, model: str | No
     which = case.simulation.model if model is None else model
     if which not in ("I", "II"):
         raise InputError("model", which, "'I' or 'II'")
+    check_bounded_work(case)  # before any map, matrix or step: refuse runs that would not end
     if stiffness_map is None:
         from ..stiffness import build_map
 
@@ -344,7 +444,7 @@ def simulate(case, stiffness_map: StiffnessMap | None = None, *, model: str | No
     n_last = n_settle + (count - 1) * decim
     _check_record_size(count, sim)
     out = np.full((count, K.N_REC), np.nan)
-    st, ist = initial_state(setup, static.z)
+    st, ist = initial_state(setup, _start_with_errors(setup, dyn, static))
     j = 0
     done = 0
     if progress is not None:
@@ -385,6 +485,37 @@ def _extreme_fields(case) -> list[str]:
 
     walk(data, "")
     return out
+
+
+def check_bounded_work(case) -> int:
+    """Refuse, before any work, a simulation whose step count or record would not fit.
+
+    The step count is ``(settle_time + record_time) / dt``; it must not exceed
+    ``simulation.max_steps`` (default 1e8, a few minutes to an hour of kernel time;
+    :func:`geardyn.run_limits.check_step_count`). The record must fit in memory (see
+    :func:`_check_record_size`).
+
+    Parameters
+    ----------
+    case : geardyn.config.Case
+
+    Returns
+    -------
+    int
+        Total number of time steps.
+
+    Raises
+    ------
+    InputError
+        Naming the times, the estimate and the limit, and how to raise it.
+    """
+    from ..run_limits import check_step_count
+
+    sim = case.simulation
+    steps = check_step_count(sim)
+    n_record = max(1, int(round(sim.record_time / sim.dt)))
+    _check_record_size(-(-n_record // sim.decimation), sim)
+    return steps
 
 
 def _check_record_size(count: int, sim) -> None:
@@ -440,7 +571,7 @@ def _dataset(case, dyn: DynamicModel, stiffness_map: StiffnessMap, which: str,
              decim: int, complete: bool):
     import xarray as xr
 
-    from .. import __version__
+    from .._version import __version__
     from ..config import case_to_toml
     from .model import operating_arrays
 
@@ -490,6 +621,12 @@ def _dataset(case, dyn: DynamicModel, stiffness_map: StiffnessMap, which: str,
     data["residual_after"] = ("time", rows[:, K.R_RA], {
         "units": "m", "long_name": "|b1 - b2| of the accepted solve (model II; paper Fig. 9a, "
                                    "black)"})
+    tooth_errors = int(setup.excitation[0][K.EI_ACTIVE]) == 1
+    if tooth_errors:
+        data["mesh_error"] = ("time", rows[:, K.R_E], {
+            "units": "m", "long_name": "load-share weighted tooth error e_bar of the loaded pairs "
+                                       "along the line of action (eq. 15 with p - e; "
+                                       "geardyn.modifications)"})
     sim = case.simulation
     dt_max, f_max, f_mesh = max_time_step(dyn, stiffness_map)
     mattrs = dict(stiffness_map.attrs)
@@ -534,5 +671,18 @@ def _dataset(case, dyn: DynamicModel, stiffness_map: StiffnessMap, which: str,
         "steps_without_fixed_point": int(np.sum(rows[:, K.R_RA] >= sim.tolerance)),
         "complete": int(complete),
     }
+    if setup.fp[K.FP_DRIVE_GAIN] != 0.0:
+        tp, wp = setup.speed_profile
+        attrs["speed_profile"] = (
+            f"speed-controlled drive, gain {setup.fp[K.FP_DRIVE_GAIN]:.6g} N m s/rad, target "
+            + ", ".join(f"{w:.6g} rad/s at {t:.6g} s" for t, w in zip(tp, wp, strict=True)))
+    if setup.fp[K.FP_RIP_AMP] != 0.0:
+        attrs["input_torque_ripple"] = (
+            f"{setup.fp[K.FP_RIP_AMP]:.6g} N m x sin({setup.fp[K.FP_RIP_ORDER]:.6g} theta_ref + "
+            f"{setup.fp[K.FP_RIP_PHASE]:.6g} rad), theta_ref = target speed x time")
+    if tooth_errors:
+        from ..modifications import ToothModifications
+
+        attrs["tooth_errors"] = ToothModifications.from_case(case).describe()
     return xr.Dataset(data, coords={"time": ("time", t, {"units": "s", "long_name": "time"})},
                       attrs=attrs)

@@ -28,7 +28,7 @@ MODEL_VERSIONS = {"pem": "1", "fe": "2"}
 
 def map_inputs(case, method: str, cracked: bool) -> dict:
     """Everything a stiffness map depends on, as plain data (hashed for the cache key)."""
-    from .. import __version__
+    from .._version import __version__
 
     data = {
         "geardyn": __version__,
@@ -48,6 +48,8 @@ def map_inputs(case, method: str, cracked: bool) -> dict:
         data["fe"] = case.stiffness.fe.model_dump(mode="json")
     else:
         data["body_torsion"] = case.stiffness.body_torsion
+        if case.stiffness.foundation_half_angle != "fillet":  # the default keeps earlier keys
+            data["foundation_half_angle"] = case.stiffness.foundation_half_angle
     return data
 
 
@@ -91,10 +93,31 @@ def build_map(case, *, method: str | None = None, cracked: bool = True,
         else:
             from .fe import fe_map as make
         m = make(case, dd, cracked=cracked, progress=progress)
-        return StiffnessMap(**{**m.__dict__, "attrs": {**dict(m.attrs), "inputs_hash": key}})
+        m = StiffnessMap(**{**m.__dict__, "attrs": {**dict(m.attrs), "inputs_hash": key}})
+        # as stored (list attributes as JSON text), so a fresh map equals a cached one
+        return StiffnessMap.from_dataset(m.to_dataset())
 
     m, _ = cache.get_or_build("stiffness", key, ".nc", build,
                               save=lambda obj, path: obj.to_dataset().to_netcdf(
                                   path, engine="h5netcdf"),
-                              load=StiffnessMap.from_netcdf)
+                              load=lambda path: load_cached_map(path, key))
+    return m
+
+
+def load_cached_map(path, key: str) -> StiffnessMap:
+    """Read a cached map and check that it was built for ``key`` (its ``inputs_hash``).
+
+    Raises
+    ------
+    DataFileError
+        The file is unreadable, or records other inputs (e.g. a cracked map copied over the
+        healthy map's entry): the cache then rebuilds the entry.
+    """
+    from ..errors import DataFileError
+
+    m = StiffnessMap.from_netcdf(path)
+    stored = m.attrs.get("inputs_hash")
+    if stored != key:
+        raise DataFileError(path, f"holds the map of other inputs (inputs_hash {stored!r}, "
+                                  f"expected {key!r})")
     return m

@@ -30,7 +30,6 @@ Layout of the arrays (``values[i_d, node]``, ``node = (2 c + zone) n_seg + j``)
 
 from __future__ import annotations
 
-import hashlib
 import json
 import math
 from collections.abc import Callable, Mapping
@@ -192,10 +191,6 @@ def zone_boundaries(pair, dd: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         pa.append(a)
         la.append((b - a) % tm)
     return np.asarray(pa), np.asarray(la)
-
-
-def _hash_inputs(obj: object) -> str:
-    return hashlib.sha256(json.dumps(obj, sort_keys=True, default=str).encode()).hexdigest()[:20]
 
 
 @dataclass(frozen=True)
@@ -545,8 +540,3 @@ def slot_teeth(pair, phase_a: float, n_cycles: int) -> np.ndarray:
         n_exit = round((pair.pitch_point_s + rb1 * theta - op.s_end) / pb)
         out[c] = np.mod(n_exit + 1 + np.arange(3), pair.pinion.teeth)
     return out
-
-
-def inputs_hash(payload: Mapping[str, object]) -> str:
-    """Short SHA-256 of a JSON-serialisable description of a map's inputs."""
-    return _hash_inputs(payload)

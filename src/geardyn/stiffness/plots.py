@@ -32,6 +32,14 @@ def dd_label(prefix: str, dd: float) -> str:
     return f"{prefix}{round(dd * 1e4):02d}"
 
 
+def _legend_below(fig: Figure, ax, ncols: int = 3) -> None:
+    """The legend under the axes, outside the data (constrained layout makes room)."""
+    handles, labels = ax.get_legend_handles_labels()
+    if handles:
+        fig.legend(handles, labels, loc="outside lower center", ncols=min(ncols, len(handles)),
+                   fontsize="small", frameon=False)
+
+
 def _covered(m: StiffnessMap, dds: Sequence[float]) -> list[float]:
     out = [float(d) for d in dds if m.covers(float(d))]
     if not out:
@@ -112,7 +120,7 @@ def fig_stiffness(m: StiffnessMap, dds: Sequence[float] = DEFAULT_DD, *,
     tm = m.mesh_angle
     lo, hi = theta_range or (-tm, 2 * tm)
     th = np.linspace(lo, hi, n)
-    fig = Figure(figsize=(7.5, 4.2), layout="constrained")
+    fig = Figure(figsize=(7.5, 4.8), layout="constrained")
     ax = fig.add_subplot()
     for d in _covered(m, dds):
         ax.plot(np.degrees(th), m.torsional(th, d), label=f"{dd_label('K', d)} "
@@ -121,7 +129,7 @@ def fig_stiffness(m: StiffnessMap, dds: Sequence[float] = DEFAULT_DD, *,
     ax.set_ylabel(r"combined torsional mesh stiffness $K_t$ [N m/rad]")
     ax.set_title(f"Mesh stiffness for several centre distances ({m.attrs.get('method', '?')})")
     ax.grid(True, alpha=0.3)
-    ax.legend()
+    _legend_below(fig, ax)
     return fig
 
 
@@ -144,7 +152,7 @@ def fig_load_sharing(m: StiffnessMap, dds: Sequence[float] = DEFAULT_DD, *,
     tm = m.mesh_angle
     t0 = pinion_tooth * tm
     th = np.linspace(t0 - 1.5 * tm, t0 + 1.5 * tm, n)
-    fig = Figure(figsize=(7.5, 4.2), layout="constrained")
+    fig = Figure(figsize=(7.5, 4.8), layout="constrained")
     ax = fig.add_subplot()
     for d in _covered(m, dds):
         ax.plot(np.degrees(th), pair_load_share(m, th, d, pinion_tooth),
@@ -154,7 +162,7 @@ def fig_load_sharing(m: StiffnessMap, dds: Sequence[float] = DEFAULT_DD, *,
     ax.set_ylim(-0.05, 1.05)
     ax.set_title("Load sharing ratio through one engagement")
     ax.grid(True, alpha=0.3)
-    ax.legend()
+    _legend_below(fig, ax)
     return fig
 
 
@@ -182,7 +190,7 @@ def fig_crack(healthy: StiffnessMap, cracked: StiffnessMap,
     th = np.linspace(theta_center - 2 * tm, theta_center + 2 * tm, n)
     depth = _crack_depth(cracked)
     dlab = f"{round(depth * 1e3):02d}" if depth is not None else ""
-    fig = Figure(figsize=(7.5, 4.2), layout="constrained")
+    fig = Figure(figsize=(7.5, 4.8), layout="constrained")
     ax = fig.add_subplot()
     ax.plot(np.degrees(th), healthy.torsional(th, 0.0), color="0.3", label="K00 (healthy, "
             r"$\Delta d$ = 0 mm)")
@@ -196,5 +204,5 @@ def fig_crack(healthy: StiffnessMap, cracked: StiffnessMap,
     ax.set_ylabel(r"combined torsional mesh stiffness $K_t$ [N m/rad]")
     ax.set_title(f"Healthy and cracked mesh stiffness ({cracked.attrs.get('method', '?')})")
     ax.grid(True, alpha=0.3)
-    ax.legend()
+    _legend_below(fig, ax, ncols=2)
     return fig

@@ -40,30 +40,42 @@ def _window(ds, t0: float, t1: float):
     return (t >= t0) & (t <= t1)
 
 
+def _plain_axis(ax) -> None:
+    """No offset or scientific notation on the y axis (values read as printed)."""
+    ax.ticklabel_format(axis="y", style="plain", useOffset=False)
+
+
 def fig8_design_parameters(ds, crack_angle: float | None, window: tuple[float, float]) -> Figure:
     """Fig. 8 analogue: centre distance change, operating pressure angle and contact ratio of
-    model II against time, with the crack events marked."""
-    fig = Figure(figsize=(8.5, 7.0), layout="constrained")
-    axs = fig.subplots(3, 1, sharex=True)
+    model II against time from the start of the record, with the crack events marked.
+
+    The physical contact ratio and the paper's eq. 8 value differ by more than their
+    variation, so each has its own panel (on one axis both would look flat)."""
+    fig = Figure(figsize=(8.5, 8.6), layout="constrained")
+    axs = fig.subplots(4, 1, sharex=True)
     sel = _window(ds, *window)
-    t = ds["time"].values[sel]
+    t_all = ds["time"].values
+    t0 = float(t_all[0])
+    t = t_all[sel] - t0
     axs[0].plot(t, ds["centre_distance_change"].values[sel] * 1e3, lw=0.9)
     axs[0].set_ylabel("centre distance change\n$d(t) - d$ [mm]")
     axs[1].plot(t, np.degrees(ds["pressure_angle"].values[sel]), lw=0.9)
     axs[1].set_ylabel("operating pressure\nangle [deg]")
-    axs[2].plot(t, ds["contact_ratio"].values[sel], lw=0.9, label="physical")
-    axs[2].plot(t, ds["contact_ratio_eq8"].values[sel], lw=0.9, label="paper eq. 8")
-    axs[2].set_ylabel("contact ratio [-]")
-    axs[2].legend(loc="best", fontsize=8)
-    axs[2].set_xlabel("time [s]")
+    axs[2].plot(t, ds["contact_ratio"].values[sel], lw=0.9, color="tab:green")
+    axs[2].set_ylabel("contact ratio,\nphysical [-]")
+    axs[3].plot(t, ds["contact_ratio_eq8"].values[sel], lw=0.9, color="tab:purple")
+    axs[3].set_ylabel("contact ratio,\npaper eq. 8 [-]")
+    axs[3].set_xlabel("time from the start of the record [s]")
     if crack_angle is not None:
         for tc in crack_times(ds, crack_angle):
             if window[0] <= tc <= window[1]:
                 for ax in axs:
-                    ax.axvline(tc, color="0.4", ls="--", lw=0.8)
+                    ax.axvline(tc - t0, color="0.4", ls="--", lw=0.8)
         axs[0].set_title("model II (crack events dashed)", fontsize=10)
     for ax in axs:
         ax.grid(alpha=0.3)
+        _plain_axis(ax)
+    axs[3].ticklabel_format(axis="x", style="plain", useOffset=False)
     return fig
 
 
@@ -151,16 +163,29 @@ def fig_tsa(diags: dict) -> Figure:
     return _grid(lambda s, m: f"model {m}: TSA of {SIGNALS[s][0]}", plot, diags)
 
 
-def fig_spectra(diags: dict, teeth: int, max_order: int = 160) -> Figure:
-    """Fig. 12 analogue: RMS order spectra (dB re 1 unit) of the TSAs, mesh harmonics marked."""
+def fig_spectra(diags: dict, teeth: int, max_order: int = 160, floor_db: float = 120.0) -> Figure:
+    """Fig. 12 analogue: RMS order spectra (dB re 1 unit) of the TSAs as stems, mesh harmonics
+    marked.
+
+    The mean is removed and the DC bin (order 0) is not drawn: the TSA's mean (e.g. the pinion's
+    114 rad/s) is no vibration, and after removing it the DC bin is round-off (about -400 dB)
+    that would set the scale. The axis shows ``floor_db`` dB below the largest line, as
+    ``geardyn diagnose``'s spectrum plot does.
+    """
     from ..diagnostics import order_spectrum
 
     def plot(ax, sd, sig, m):
         sp = order_spectrum(sd.tsa.average - np.mean(sd.tsa.average), scaling="rms", db=True)
-        k = sp.orders <= max_order
-        ax.plot(sp.orders[k], sp.amplitude[k], lw=0.7, color=COLORS[m])
+        k = (sp.orders >= 1) & (sp.orders <= max_order)
+        orders, amp = sp.orders[k], np.asarray(sp.amplitude)[k]
+        finite = amp[np.isfinite(amp)]
+        top = float(finite.max()) if finite.size else 0.0
+        floor = top - floor_db
+        ax.vlines(orders, floor, np.maximum(amp, floor), lw=0.8, color=COLORS[m])
         for h in range(teeth, max_order + 1, teeth):
             ax.axvline(h, color="0.6", ls=":", lw=0.7)
+        ax.set_xlim(0, max_order)
+        ax.set_ylim(floor, top + 10.0)
         ax.set_xlabel("shaft order [-]")
         ax.set_ylabel(f"RMS [dB re 1 {SIGNALS[sig][1]}]")
 
@@ -189,12 +214,17 @@ def fig_pwvd_pair(diags: dict, sig: str, which: str, teeth: int, max_order: floa
         sd = diags[m].signals[sig]
         pw = sd.pwvd_tsa if which == "tsa" else sd.pwvd_residual
         k = pw.orders <= max_order
-        ang = np.degrees(pw.angle - pw.angle[0])
-        d = pw.distribution[:, k] if pw.distribution.shape[0] == ang.size else \
+        n_ang = pw.angle.size
+        d = pw.distribution[:, k] if pw.distribution.shape[0] == n_ang else \
             pw.distribution[k, :].T
+        # cell edges: angle bins tile 0..360 deg exactly (no blank strip at 360 deg)
+        ang_edges = np.arange(n_ang + 1) * 360.0 / n_ang
+        o = pw.orders[k]
+        step = o[1] - o[0] if o.size > 1 else 1.0
+        order_edges = np.concatenate([o - step / 2, [o[-1] + step / 2]])
         vmax = np.max(np.abs(d)) or 1.0
-        im = ax.pcolormesh(ang, pw.orders[k], d.T, shading="auto", cmap="viridis",
-                           vmin=0, vmax=vmax, rasterized=True)
+        im = ax.pcolormesh(ang_edges, np.maximum(order_edges, 0.0), d.T, shading="flat",
+                           cmap="viridis", vmin=0, vmax=vmax, rasterized=True)
         for h in range(teeth, int(max_order) + 1, teeth):
             ax.axhline(h, color="w", ls=":", lw=0.5, alpha=0.6)
         ax.set_title(f"model {m}: PWVD of the {'TSA' if which == 'tsa' else 'residual'} of "

@@ -191,8 +191,14 @@ def direct_contact(pinion: ElasticBody, gear: ElasticBody, pair, theta: float, d
     n = len(rows1) + len(rows2)
     if n == 0:
         raise NumericalError("no contact candidates in the direct solve", state={"theta": theta})
-    G1 = sp.lil_matrix((n, pinion.n_dofs))
-    G2 = sp.lil_matrix((n, gear.n_dofs))
+    # constraint rows assembled as COO triplets (row, dof, value), converted once to CSR
+    G1: tuple[list, list, list] = ([], [], [])
+    G2: tuple[list, list, list] = ([], [], [])
+
+    def put(g, r, col, val):
+        g[0].append(r)
+        g[1].append(col)
+        g[2].append(val)
     gap = np.zeros(n)
     arm = np.zeros(n)
     pair_of = np.zeros(n, dtype=np.int64)
@@ -206,13 +212,13 @@ def direct_contact(pinion: ElasticBody, gear: ElasticBody, pair, theta: float, d
     for _, i, k, t, nv, g, xp in rows1:
         nb1 = r1.T @ nv  # normal in the pinion body frame
         for c in range(2):
-            G1[row, d1[c, i]] += nb1[c]
+            put(G1, row, d1[c, i], nb1[c])
         nb2 = r2.T @ nv
         w = edge_weights(t)
         dd2 = [nd2[:, seg2[0, k]], nd2[:, seg2[1, k]], fd2[:, fac2[k]]]
         for a in range(3):
             for c in range(2):
-                G2[row, dd2[a][c]] += w[a] * nb2[c]
+                put(G2, row, dd2[a][c], w[a] * nb2[c])
         gap[row] = g
         arm[row] = xp[0] * nv[1] - xp[1] * nv[0]
         # pair: the gear tooth of the segment (gear tooth q = model offset q)
@@ -224,16 +230,16 @@ def direct_contact(pinion: ElasticBody, gear: ElasticBody, pair, theta: float, d
         dd1 = [nd1[:, seg1[0, k]], nd1[:, seg1[1, k]], fd1[:, fac1[k]]]
         for a in range(3):
             for c in range(2):
-                G1[row, dd1[a][c]] += w[a] * nb1[c]
+                put(G1, row, dd1[a][c], w[a] * nb1[c])
         nb2 = r2.T @ nv
         for c in range(2):
-            G2[row, nd2[c, corner[i]]] += nb2[c]
+            put(G2, row, nd2[c, corner[i]], nb2[c])
         gap[row] = g
         arm[row] = xp[0] * nv[1] - xp[1] * nv[0]
         pair_of[row] = -int(tooth_seg1[k])  # pinion tooth p = model offset -p
         row += 1
-    G1 = G1.tocsr()
-    G2 = G2.tocsr()
+    G1 = sp.coo_matrix((G1[2], (G1[0], G1[1])), shape=(n, pinion.n_dofs)).tocsr()
+    G2 = sp.coo_matrix((G2[2], (G2[0], G2[1])), shape=(n, gear.n_dofs)).tocsr()
     W = G1 @ pinion.solve(G1.T.toarray()) + G2 @ gear.solve(G2.T.toarray())
     W = 0.5 * (W + W.T)
     L = np.linalg.cholesky(W + 1e-14 * np.trace(W) / n * np.eye(n))

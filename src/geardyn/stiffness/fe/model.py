@@ -104,7 +104,7 @@ class FESettings:
 def body_inputs(gear: Gear, material: ElasticMaterial, settings: FESettings,
                 crack: CrackGeometry | None) -> dict:
     """Everything a body's influence coefficients depend on (hashed for the cache)."""
-    from ... import __version__
+    from ..._version import __version__
 
     g = asdict(gear)
     g.pop("face_width", None)  # 2-D per unit width: the face width enters later

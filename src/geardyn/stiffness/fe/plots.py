@@ -81,8 +81,8 @@ def plot_body_mesh(case, *, cracked: bool = True, zoom: bool = True,
     draw_mesh(axes[0], mesh, (-half, half, gear.root_radius - 3.5 * m, gear.tip_radius + 0.3 * m))
     which = "cracked " if crack is not None else ""
     name = "pinion" if gear is pair.pinion else "gear"
-    axes[0].set_title(f"{which}{name} tooth: {mesh.n_triangles} triangles (whole gear), "
-                      f"P2, plane {settings.plane}")
+    axes[0].set_title(f"{which}{name} tooth: {mesh.n_triangles} triangles (whole gear),\n"
+                      f"P2, plane {settings.plane}", fontsize="medium")
     if zoom:
         if crack is not None:
             c = 0.5 * (mesh.crack_mouth + mesh.crack_tip)
@@ -107,12 +107,12 @@ def plot_body_mesh(case, *, cracked: bool = True, zoom: bool = True,
         if crack is not None:
             tip = mesh.crack_tip * 1e3
             axes[1].plot(tip[0], tip[1], "o", ms=5, mfc="none", color="tab:red")
-            title = (f"{crack.depth * 1e3:g} mm root crack at {math.degrees(crack.angle):g} deg: "
+            title = (f"{crack.depth * 1e3:g} mm root crack at {math.degrees(crack.angle):g} deg:\n"
                      "duplicated nodes, free faces")
             if opening:
                 title += f"\n(deformed under {settings.torque:g} N m at the pitch point, " \
                          f"x{scale:.0f})"
-            axes[1].set_title(title)
+            axes[1].set_title(title, fontsize="medium")
         else:
             axes[1].set_title("loaded flank and fillet")
     return fig

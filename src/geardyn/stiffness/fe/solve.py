@@ -175,14 +175,10 @@ class ElasticBody:
         keys = np.minimum(f[0], f[1]).astype(np.int64) * n + np.maximum(f[0], f[1])
         self._facet_order = np.argsort(keys)
         self._facet_keys = keys[self._facet_order]
-        bore = mesh.edges["bore"]
-        bf = self.facet_index(bore)
-        fixed = np.unique(np.concatenate([self.basis.nodal_dofs[:, np.unique(bore)].ravel(),
-                                          self.basis.facet_dofs[:, bf].ravel()]))
-        self.fixed = fixed
-        mask = np.ones(self.basis.N, bool)
-        mask[fixed] = False
-        self.free = np.nonzero(mask)[0]
+        bf = self.facet_index(mesh.edges["bore"])
+        # every DOF on the bore facets (vertex and midside, both components), by scikit-fem
+        self.fixed = np.unique(self.basis.get_dofs(facets=bf).all())
+        self.free = np.setdiff1d(np.arange(self.basis.N), self.fixed)
         self._lu = None
         self.t_factor = 0.0
 
@@ -203,9 +199,11 @@ class ElasticBody:
 
     def factor(self):
         """The SuperLU factorisation of the free-free stiffness (computed once)."""
+        from skfem import condense
+
         if self._lu is None:
             t0 = time.perf_counter()
-            kff = self.K[self.free][:, self.free].tocsc()
+            kff = condense(self.K, D=self.fixed, expand=False).tocsc()
             self._lu = splu(kff, permc_spec="MMD_AT_PLUS_A",
                             options={"SymmetricMode": True})
             self.t_factor = time.perf_counter() - t0

@@ -50,6 +50,18 @@ result, e.g. ``v_yg__FM4``, each with ``units`` and ``long_name`` (see
 text, the effective base case (TOML), the sweep hash, the batch size and the grid shape. Open it
 with ``xarray.open_zarr`` or :func:`open_sweep` (``unstack=True`` gives one dimension per axis).
 
+**Integrity.** Each batch's task writes a SHA-256 checksum of the values it wrote (variable
+``batch_checksum``, dimension ``batch``) after its data chunks and before its status chunk. A
+resume and :func:`open_sweep` verify every finished batch against it (a deleted, garbage or
+swapped chunk fails); a resume puts damaged batches back to pending and names them in
+:attr:`SweepResult.damaged`; :func:`verify_store` (``geardyn sweep --verify STORE``) checks without
+computing. A missing consolidated metadata file is rebuilt on resume. See
+:mod:`geardyn.studies.sweep.integrity`.
+
+**Bounds.** A sweep of more than :data:`DEFAULT_MAX_RUNS` runs is refused before anything is
+expanded, with the count and the limit in the message; ``max_runs=`` (``--max-runs``) or
+``$GEARDYN_MAX_RUNS`` raises the limit.
+
 **Execution and safety.** The store must be on a filesystem every worker sees (checked before
 any task runs). The template (metadata, coordinates, ``status = 0``) is written first, into a
 temporary folder renamed into place. The runs are cut into batches of ``batch_size`` consecutive
@@ -77,7 +89,9 @@ Entry points: :func:`load_sweep`, :meth:`Sweep.plan`, :func:`run_sweep`, :func:`
 
 from .evaluate import Evaluator, GeardynEvaluator, Output, diagnostic_features, evaluate_run
 from .execute import SweepResult, run_sweep, sweep_digest
+from .integrity import DamagedBatch, StoreCheck, verify_store
 from .spec import (
+    DEFAULT_MAX_RUNS,
     DEFAULT_SIGNALS,
     Parameter,
     Sweep,
@@ -119,4 +133,8 @@ __all__ = [
     "sweep_digest",
     "open_sweep",
     "store_status",
+    "verify_store",
+    "StoreCheck",
+    "DamagedBatch",
+    "DEFAULT_MAX_RUNS",
 ]

@@ -7,6 +7,7 @@ and the diagnostics chain on the paper's three signals.
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -140,9 +141,9 @@ _SUMMARY = [
 
 
 def _kurt(x: np.ndarray) -> float:
-    from ...diagnostics import kurtosis
+    from ...diagnostics import kurtosis  # the one kurtosis helper (NaN for a constant record)
 
-    return kurtosis(x) if np.ptp(x) > 0 else math.nan
+    return kurtosis(x, warn_constant=False)
 
 
 def diagnostic_features(signals: Mapping[str, np.ndarray], angle: np.ndarray, *, teeth: int,
@@ -217,23 +218,37 @@ def diagnostic_features(signals: Mapping[str, np.ndarray], angle: np.ndarray, *,
     return out
 
 
-_MAPS: dict[str, Any] = {}  # stiffness maps of this worker process, by the inputs' hash
-_MAPS_MAX = 32
+class _MapRequest:
+    """A case that hashes and compares by the key of its map's inputs (the memo's key)."""
+
+    __slots__ = ("key", "case")
+
+    def __init__(self, key: str, case: Case):
+        self.key, self.case = key, case
+
+    def __hash__(self) -> int:
+        return hash(self.key)
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, _MapRequest) and other.key == self.key
+
+
+@functools.lru_cache(maxsize=32)
+def _cached_map(request: _MapRequest):
+    """The stiffness maps of this worker process: the 32 most recently used, by inputs' key."""
+    from ...stiffness import build_map
+
+    return build_map(request.case, cracked=True)
 
 
 def _stiffness_map(case: Case):
-    """The case's (cracked) stiffness map, memoised per process by its inputs' hash."""
+    """The case's (cracked) stiffness map, memoised per process by its inputs' hash
+    (:func:`geardyn.cache.cache_key` of :func:`geardyn.stiffness.map_inputs`, the key of the
+    disk cache)."""
     from ...cache import cache_key
-    from ...stiffness import build_map, map_inputs
+    from ...stiffness import map_inputs
 
-    key = cache_key(map_inputs(case, case.stiffness.method, True))
-    m = _MAPS.get(key)
-    if m is None:
-        m = build_map(case, cracked=True)
-        if len(_MAPS) >= _MAPS_MAX:
-            _MAPS.pop(next(iter(_MAPS)))
-        _MAPS[key] = m
-    return m
+    return _cached_map(_MapRequest(cache_key(map_inputs(case, case.stiffness.method, True)), case))
 
 
 def evaluate_run(case: Case, store_options: StoreSpec | None = None, seed: int = 0

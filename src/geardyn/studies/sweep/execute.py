@@ -25,6 +25,7 @@ import numpy as np
 from ...config import Case
 from ...errors import DataFileError, InputError
 from .evaluate import Evaluator, GeardynEvaluator, Output
+from .integrity import verify_store
 from .spec import Sweep, SweepPlan, load_sweep
 from .store import (
     STATUS_FAILED,
@@ -163,6 +164,13 @@ class SweepResult:
     incomplete_tasks : list of str
         Tasks that failed as a whole (lost workers beyond Dask's retries, store errors); their
         runs are still pending and a re-run computes them.
+    damaged : list of str
+        Batches of a resumed store whose stored values failed their checksum (deleted, garbage
+        or swapped chunks), put back to pending and computed again in this call, e.g.
+        ``"batch 1 (runs 5-9): the stored values differ from their checksum"``.
+    metadata_rebuilt : bool
+        The store's consolidated metadata (``.zmetadata``) was missing or unreadable and was
+        rebuilt from the per-variable metadata.
     """
 
     out: Path
@@ -179,6 +187,8 @@ class SweepResult:
     task_seconds: float = 0.0
     resumed: bool = False
     incomplete_tasks: list[str] = field(default_factory=list)
+    damaged: list[str] = field(default_factory=list)
+    metadata_rebuilt: bool = False
 
 
 def sweep_digest(sweep: Sweep, evaluator: Evaluator) -> str:
@@ -266,15 +276,21 @@ def run_sweep(
     Returns
     -------
     SweepResult
+        On resume, :attr:`SweepResult.damaged` names the batches whose stored values failed
+        their checksums (they were put back to pending and computed again).
 
     Raises
     ------
     InputError
-        ``--out`` holds another sweep, a bad ``--scheduler``, no workers.
+        ``--out`` holds another sweep, a bad ``--scheduler``, no workers, or more runs than
+        the sweep's limit (see :func:`~geardyn.studies.sweep.load_sweep`).
     DataFileError
         ``out`` is not a sweep store, or the workers cannot see it.
     """
     t_start = time.perf_counter()
+    from ..._optional import require_extra
+
+    require_extra("sweep")  # dask, distributed, zarr: a clear error naming the extra
     if not isinstance(sweep, Sweep):
         sweep = load_sweep(sweep)
     if workers is not None and (isinstance(workers, bool) or workers < 1):
@@ -293,6 +309,9 @@ def run_sweep(
     batch, outputs = 0, ()
     if resumed:
         _remove_partials(out)
+        check = verify_store(out, repair=True)  # damaged batches go back to pending
+        result.damaged = [str(d) for d in check.damaged]
+        result.metadata_rebuilt = check.metadata == "rebuilt"
         status = store_status(out, repair=True)
         batch = int(_read_attrs(out)["batch_size"])
         outputs = _outputs_from_store(out)

@@ -8,8 +8,11 @@ type unstable). One dimension ``run``; every variable is chunked along it in bat
 Crash safety: zarr-python's ``LocalStore`` (since 3.1.3, zarr-python PR #3412; zarr 2's
 ``DirectoryStore`` did the same) writes each chunk to ``<key>.<uuid>.partial`` and renames it
 over the key (``tests/sweep/test_store.py`` checks this on the installed version), so a chunk is
-either the old one or the new one. A task writes its data chunks first and the status chunk
-last: a batch killed in between is still pending and is redone with the same values. Stale
+either the old one or the new one. A task writes its data chunks first, then the batch's
+checksum (:mod:`.integrity`), and the status chunk last: a batch killed in between is still
+pending and is redone with the same values; a finished batch whose chunks were later deleted,
+garbled or swapped fails its checksum on resume and is redone too. Only zarr's public API is
+used (``zarr.open_group`` and array slicing). Stale
 ``*.partial`` files are removed when a sweep resumes. With a store that does not write
 atomically the design degrades gracefully: a torn data chunk belongs to a batch whose status was
 never written (so it is redone), and a torn (undecodable) status chunk counts as pending. Writes
@@ -35,7 +38,17 @@ import numpy as np
 
 from ...config import Case
 from ...errors import DataFileError, GeardynError, InputError
+from ...io import remove_stale_temp_files, temp_prefix
 from .evaluate import Evaluator, Output
+from .integrity import (
+    CHECKSUM_CHARS,
+    CHECKSUM_VAR,
+    _consolidated_ok,
+    batch_digest,
+    check_metadata,
+    open_store_group,
+    verify_store,
+)
 from .spec import STORE_FORMAT, Sweep, SweepPlan
 
 __all__ = ["STATUS_PENDING", "STATUS_OK", "STATUS_FAILED", "ERROR_CHARS", "open_sweep",
@@ -59,10 +72,8 @@ def _is_store(path: Path) -> bool:
 
 
 def _read_attrs(path: Path) -> dict:
-    import zarr
-
     try:
-        g = zarr.open_group(str(path), mode="r")
+        g = open_store_group(path, "r")
         return dict(g.attrs)
     except Exception as exc:  # corrupt metadata of any kind
         raise DataFileError(path, f"is not a readable Zarr store ({type(exc).__name__}: {exc})"
@@ -75,7 +86,7 @@ def _template(sweep: Sweep, plan: SweepPlan, digest: str, evaluator: Evaluator, 
     import dask.array as da
     import xarray as xr
 
-    from ... import __version__
+    from ..._version import __version__
 
     n = plan.n_runs
     ds = xr.Dataset(coords={"run": ("run", np.arange(n, dtype=np.int64),
@@ -100,6 +111,10 @@ def _template(sweep: Sweep, plan: SweepPlan, digest: str, evaluator: Evaluator, 
         ds[o.name] = (("run", *o.dims), da.full((n, *o.shape), np.nan,
                                                 chunks=(batch, *o.shape)),
                       {"units": o.units, "long_name": o.long_name})
+    ds[CHECKSUM_VAR] = ("batch", da.full(-(-n // batch), "", dtype=f"<U{CHECKSUM_CHARS}",
+                                         chunks=1),
+                        {"long_name": "SHA-256 of the values of the batch's runs, written before "
+                                      "their status (see geardyn.studies.sweep.integrity)"})
     ds.attrs = {
         "title": f"geardyn sweep {sweep.spec.name}",
         "description": sweep.spec.description,
@@ -123,6 +138,7 @@ def _template(sweep: Sweep, plan: SweepPlan, digest: str, evaluator: Evaluator, 
         "n_runs": n,
         "created": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
         "status_codes": "0 pending, 1 ok, 2 failed",
+        "checksum_variables": sorted([*_CORE_VARS, *(o.name for o in outputs)]),
     }
     return ds
 
@@ -155,7 +171,9 @@ def _create_store(out: Path, ds, batch: int) -> None:
             if v.dtype.kind == "f":
                 enc["_FillValue"] = np.nan
             encoding[name] = enc
-    tmp = out.with_name(f".{out.name}.{uuid.uuid4().hex[:12]}.partial")
+    encoding[CHECKSUM_VAR] = {"chunks": (1,)}
+    remove_stale_temp_files(out.parent, out.name)  # left by a process killed while creating
+    tmp = out.with_name(f"{temp_prefix(out)}{uuid.uuid4().hex[:12]}.partial")
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", category=UserWarning)
@@ -184,9 +202,7 @@ def _remove_partials(out: Path) -> int:
 
 
 def _open_group(out: Path, mode: str = "r+"):
-    import zarr
-
-    return zarr.open_group(str(out), mode=mode, use_consolidated=True)
+    return open_store_group(out, mode)
 
 
 def store_status(out: str | os.PathLike, *, repair: bool = False) -> np.ndarray:
@@ -250,31 +266,18 @@ _RUN_VARS: dict[str, tuple[str, Any, dict]] = {
 
 def _write_batch(out: str, start: int, stop: int, results: Mapping[int, RunRecord],
                  outputs: Sequence[Output]) -> None:
-    """Write one chunk ``[start, stop)``: data variables first, the status last.
+    """Write one chunk ``[start, stop)``: data variables first, then the batch's checksum, the
+    status last.
 
     ``results`` maps run -> :class:`RunRecord` for the runs computed; the other runs of the
     chunk keep their stored values (a resumed chunk). The chunks of the data variables are
-    written concurrently (zarr's asynchronous API, about twice as fast as one by one); the
-    status chunk is written only after all of them are in place.
+    written concurrently from a few threads through zarr's public synchronous API; the checksum
+    (:func:`.integrity.batch_digest` of every value of the chunk, the status included) is
+    written once all of them are in place, and the status chunk after it.
     """
-    try:
-        from zarr.core.sync import sync  # zarr's own bridge to its event loop (zarr >= 3)
-    except ImportError:  # pragma: no cover - a zarr without it: plain asyncio
-        import asyncio
+    from concurrent.futures import ThreadPoolExecutor
 
-        def sync(coro):
-            return asyncio.run(coro)
-
-    sync(_write_batch_async(out, start, stop, results, outputs))
-
-
-async def _write_batch_async(out: str, start: int, stop: int,
-                             results: Mapping[int, RunRecord], outputs: Sequence[Output]):
-    import asyncio
-
-    import zarr.api.asynchronous as za
-
-    g = await za.open_group(str(out), mode="r+", use_consolidated=True)
+    g = open_store_group(out, "r+")
     full = len(results) == stop - start
     n = stop - start
     specs: list[tuple[str, tuple, Any, Any, Callable[[RunRecord], Any]]] = [
@@ -283,23 +286,31 @@ async def _write_batch_async(out: str, start: int, stop: int,
     specs += [(name, (), dtype, fill,
                lambda rec, name=name: getattr(rec, "seconds" if name == "run_seconds" else name))
               for name, (dtype, fill, _) in _RUN_VARS.items()]
-    arrays = await asyncio.gather(*(g.getitem(name) for name, *_ in specs), g.getitem("status"))
-    status_arr = arrays[-1]
+    arrays = [g[name] for name, *_ in specs]
+    status_arr = g["status"]
     if full:
         blocks = [np.full((n, *shape), fill, dtype=dtype) for _, shape, dtype, fill, _ in specs]
         status = np.full(n, STATUS_PENDING, dtype=np.int8)
     else:  # keep the runs of the chunk that are not recomputed
-        current = await asyncio.gather(*(a.getitem(slice(start, stop)) for a in arrays))
-        blocks = [np.array(c, dtype=sp[2]) for c, sp in zip(current[:-1], specs, strict=True)]
-        status = np.array(current[-1], dtype=np.int8)
+        blocks = [np.array(a[start:stop], dtype=sp[2]) for a, sp in zip(arrays, specs, strict=True)]
+        status = np.array(status_arr[start:stop], dtype=np.int8)
     for blk, (_, _, _, _, get) in zip(blocks, specs, strict=True):
         for run, rec in results.items():
             blk[run - start] = get(rec)
-    await asyncio.gather(*(a.setitem(slice(start, stop), blk)
-                           for a, blk in zip(arrays[:-1], blocks, strict=True)))
     for run, rec in results.items():
         status[run - start] = rec.status
-    await status_arr.setitem(slice(start, stop), status)  # last: the batch is done from here
+
+    def put(item) -> None:
+        arr, blk = item
+        arr[start:stop] = blk
+
+    with ThreadPoolExecutor(max_workers=min(8, len(arrays))) as pool:
+        list(pool.map(put, zip(arrays, blocks, strict=True)))
+    columns = {sp[0]: blk for sp, blk in zip(specs, blocks, strict=True)} | {"status": status}
+    batch = start // status_arr.chunks[0]
+    g[CHECKSUM_VAR][batch:batch + 1] = np.array([batch_digest(start, stop, columns)],
+                                                dtype=f"<U{CHECKSUM_CHARS}")
+    status_arr[start:stop] = status  # last: the batch is done from here
 
 
 def _clip(text: str, n: int = ERROR_CHARS) -> str:
@@ -334,6 +345,8 @@ def _check_out(out: Path, digest: str, force: bool) -> bool:
     if not out.is_dir() or not _is_store(out):
         raise DataFileError(out, "exists and is not a Zarr store; choose another --out")
     attrs = _read_attrs(out)
+    if "geardyn_sweep" not in attrs and (out / CHECKSUM_VAR).is_dir():
+        check_metadata(out, rebuild=False)  # a sweep store that lost its attributes: say which
     if "geardyn_sweep" not in attrs:
         raise DataFileError(out, "is a Zarr store but not a geardyn sweep; choose another --out")
     if attrs.get("sweep_hash") == digest:
@@ -351,7 +364,7 @@ def _outputs_from_store(out: Path) -> tuple[Output, ...]:
     """The result variables as laid out in an existing store."""
     import xarray as xr
 
-    with xr.open_zarr(str(out), consolidated=True) as ds:
+    with xr.open_zarr(str(out), consolidated=_consolidated_ok(out)) as ds:
         return tuple(Output(str(name), v.attrs.get("units", ""), v.attrs.get("long_name", ""),
                             tuple(str(d) for d in v.dims[1:]), tuple(v.shape[1:]))
                      for name, v in ds.data_vars.items()
@@ -361,7 +374,8 @@ def _outputs_from_store(out: Path) -> tuple[Output, ...]:
 # ============================================================================================
 # reading
 # ============================================================================================
-def open_sweep(path: str | os.PathLike, *, only_ok: bool = False, unstack: bool = False):
+def open_sweep(path: str | os.PathLike, *, only_ok: bool = False, unstack: bool = False,
+               verify: bool = True):
     """Open a sweep store with xarray.
 
     Parameters
@@ -373,19 +387,39 @@ def open_sweep(path: str | os.PathLike, *, only_ok: bool = False, unstack: bool 
     unstack : bool
         Reshape a grid sweep (axes only, no sampling, no failed filtering) into one dimension
         per axis, named by its dotted key.
+    verify : bool
+        Check every finished batch against its checksum first
+        (:func:`~geardyn.studies.sweep.integrity.verify_store`; this reads the whole store once).
+        Stores written before checksums existed are opened unchecked.
 
     Returns
     -------
     xarray.Dataset
+
+    Raises
+    ------
+    DataFileError
+        Not a sweep store, damaged metadata, or (with ``verify``) batches whose values do not
+        match their checksums: the message names them; resuming the sweep recomputes them.
     """
     import xarray as xr
 
+    from ..._optional import require_extra
+
+    require_extra("sweep")  # zarr (and dask for the lazy arrays): a clear error naming the extra
     p = Path(path)
     if not _is_store(p):
         raise DataFileError(p, "is not a Zarr store")
-    ds = xr.open_zarr(str(p), consolidated=True)
+    metadata = check_metadata(p, rebuild=False)
+    ds = xr.open_zarr(str(p), consolidated=metadata == "ok")
     if "geardyn_sweep" not in ds.attrs:
         raise DataFileError(p, "is not a geardyn sweep store")
+    if verify and "checksum_variables" in ds.attrs:
+        check = verify_store(p)
+        if not check.ok:
+            raise DataFileError(p, f"is damaged: {check.summary(3)}; re-run the same `geardyn "
+                                   "sweep` command to recompute those runs (or open_sweep(..., "
+                                   "verify=False) to read it as it is)")
     if only_ok:
         ds = ds.isel(run=np.flatnonzero(ds["status"].values == STATUS_OK))
     if unstack:

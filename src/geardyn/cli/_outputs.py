@@ -1,0 +1,314 @@
+"""Output folders that know which inputs made them: re-runs, resumes and clear refusals.
+
+Every command that writes results records the identity of its inputs (the command, a hash of the
+effective case, the options that change results, the geardyn version) in the output folder's
+``inputs.json`` *before* it writes anything else, with ``"complete": false``, and rewrites it with
+``"complete": true`` (and which cache entries it reused) as its very last step. So:
+
+- running the same command twice into the same folder just works (the cache makes it fast);
+- an interrupted run (Ctrl-C, a kill) leaves a folder whose record says ``complete: false``, and
+  re-running the same command continues into it;
+- a folder holding results of *different* inputs is refused, naming what differs, unless
+  ``--force``;
+- a folder with results but no record (an older geardyn, files put there by hand) is refused
+  unless ``--force``.
+
+``geardyn simulate`` writes one file; its identity goes into the file's ``geardyn_inputs``
+attribute instead (see :mod:`geardyn.cli.simulate`).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from ..errors import InputError
+
+__all__ = ["OutputTarget", "OutputInUse", "RECORD", "identity", "check_writable", "claim_folder", "begin",
+           "mark_complete", "read_record", "differences", "refuse_different", "resolve",
+           "cache_summary", "say_state", "say_cache"]
+
+#: Name of the inputs record in an output folder.
+RECORD = "inputs.json"
+
+#: Case values that do not change any result (left out of the identity).
+_NOT_RESULTS = {"name", "simulation.max_steps"}
+
+
+class OutputInUse(InputError):
+    """The output already holds results this command must not replace (exit 2).
+
+    The message reads ``<output> <problem>; <remedy>``, e.g. ``--out runs/a holds results of
+    different inputs (simulation.record_time 1.0 -> 0.2); ...``.
+    """
+
+    def __init__(self, label: str, problem: str, remedy: str):
+        super().__init__(label, problem, remedy)
+        self.args = (f"{label} {problem}; {remedy}",)
+
+    def __str__(self) -> str:
+        return str(self.args[0])
+
+
+@dataclass(frozen=True)
+class OutputTarget:
+    """Where a command writes, and how to name it in a message.
+
+    Attributes
+    ----------
+    path : Path
+        The output folder (or file, for ``simulate``).
+    given : bool
+        Whether the user gave ``--out``; messages name ``--out`` only then.
+    """
+
+    path: Path
+    given: bool
+
+    @property
+    def label(self) -> str:
+        """``--out PATH`` if the user gave it, else ``the default output folder PATH``."""
+        text = _short(str(self.path))
+        if self.given:
+            return f"--out {text}"
+        kind = "file" if self.path.suffix else "folder"
+        return f"the default output {kind} {text}"
+
+
+def _short(text: str, n: int = 160) -> str:
+    return text if len(text) <= n else text[: n // 2 - 2] + "..." + text[-(n // 2 - 2):]
+
+
+def resolve(out: Path | None, default: Path) -> OutputTarget:
+    """The output target for an ``--out`` value that may be absent."""
+    return OutputTarget(default if out is None else Path(out), out is not None)
+
+
+def _flatten(node: Any, prefix: str = "") -> dict[str, Any]:
+    if isinstance(node, dict):
+        flat: dict[str, Any] = {}
+        for k, v in node.items():
+            flat.update(_flatten(v, f"{prefix}.{k}" if prefix else str(k)))
+        return flat
+    return {prefix: node}
+
+
+def identity(command: str, case=None, options: dict[str, Any] | None = None,
+             files: dict[str, Path] | None = None) -> dict[str, Any]:
+    """What makes a command's results what they are.
+
+    Parameters
+    ----------
+    command : str
+        ``"run"``, ``"stiffness"``...
+    case : geardyn.config.Case, optional
+        The effective case (after ``--config`` and ``--set``); its values (not its provenance or
+        name) are hashed.
+    options : dict, optional
+        Command-line options that change the results (JSON-serialisable).
+    files : dict of str -> Path, optional
+        Input files; their SHA-256 is part of the identity.
+    """
+    from .._version import __version__
+    from ..cache import cache_key
+    from ..io import json_safe
+
+    ident: dict[str, Any] = {"command": command, "options": json_safe(options or {}),
+                             "geardyn": __version__}
+    if case is not None:
+        from ..config import deep_copy_case_data
+
+        values = {k: v for k, v in _flatten(json_safe(deep_copy_case_data(case))).items()
+                  if k not in _NOT_RESULTS}
+        ident["case_name"] = case.name
+        ident["case_hash"] = cache_key(values)
+        ident["case"] = values
+    if files:
+        import hashlib
+
+        digests = {}
+        for name, path in files.items():
+            h = hashlib.sha256()
+            with open(path, "rb") as fh:
+                for chunk in iter(lambda fh=fh: fh.read(1 << 20), b""):
+                    h.update(chunk)
+            digests[name] = {"path": str(path), "sha256": h.hexdigest()}
+        ident["files"] = digests
+    return ident
+
+
+def differences(old: dict[str, Any], new: dict[str, Any]) -> list[str]:
+    """What differs between two identities, in words (empty: the same inputs)."""
+    if old.get("command") != new.get("command"):
+        return [f"they were made by 'geardyn {old.get('command')}'"]
+    diff = []
+    if old.get("case_hash") != new.get("case_hash"):
+        a, b = old.get("case") or {}, new.get("case") or {}
+        # keys on one side only are fields another geardyn version added or removed
+        keys = sorted(k for k in set(a) & set(b) if a[k] != b[k])
+        diff += [f"{k} {_short(repr(a.get(k)), 40)} -> {_short(repr(b.get(k)), 40)}"
+                 for k in keys]
+    oa, ob = old.get("options") or {}, new.get("options") or {}
+    diff += [f"{k} {_short(repr(oa.get(k)), 40)} -> {_short(repr(ob.get(k)), 40)}"
+             for k in sorted(set(oa) | set(ob)) if oa.get(k) != ob.get(k)]
+    fa, fb = old.get("files") or {}, new.get("files") or {}
+    for k in sorted(set(fa) | set(fb)):
+        if (fa.get(k) or {}).get("sha256") != (fb.get(k) or {}).get("sha256"):
+            diff.append(f"the content of {k} {_short((fb.get(k) or fa.get(k) or {}).get('path', ''), 60)}")
+    return diff
+
+
+def refuse_different(target: OutputTarget, diff: list[str]) -> InputError:
+    """The error for an output holding results of different inputs."""
+    shown = "; ".join(diff[:3]) + (f"; and {len(diff) - 3} more" if len(diff) > 3 else "")
+    return OutputInUse(target.label, f"holds results of different inputs ({shown})",
+                       "pass --force to replace them, or choose another output with --out")
+
+
+def check_writable(target: OutputTarget, *, folder: bool = True) -> None:
+    """Refuse, before any work, an output that cannot be written.
+
+    ``folder=True``: the target must be a folder (or not exist yet, under a writable folder);
+    ``folder=False``: a file path (not an existing folder) in a writable folder.
+    """
+    p = target.path
+    if folder and p.exists() and not p.is_dir():
+        raise InputError(target.label, "an existing file", "a folder (or a path that does not "
+                                                           "exist yet)")
+    if not folder and p.is_dir():
+        raise InputError(target.label, "an existing folder", "a file path")
+    probe = p if folder else p.parent
+    probe = Path(os.path.abspath(probe))
+    while not probe.exists():
+        if probe.parent == probe:
+            break
+        probe = probe.parent
+    if not probe.is_dir():
+        raise InputError(target.label, f"{_short(str(probe))} is a file, not a folder",
+                         "a path whose parent folders are folders")
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=".geardyn-write-test.", dir=probe)
+    except OSError as exc:
+        raise InputError(target.label, f"cannot write in {_short(str(probe))} "
+                                       f"({exc.strerror or exc})",
+                         "a folder you can write to" + ("" if target.given else
+                                                        " (choose one with --out)")) from None
+    os.close(fd)
+    os.unlink(tmp)
+
+
+def read_record(folder: Path) -> dict[str, Any] | None:
+    """The folder's inputs record, or None if there is none (or it is unreadable)."""
+    try:
+        data = json.loads((folder / RECORD).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    return data if isinstance(data, dict) and "identity" in data else None
+
+
+def claim_folder(target: OutputTarget, ident: dict[str, Any], *, force: bool,
+                 results: list[str], record: bool = True) -> str:
+    """Check that ``target`` may receive the results of ``ident`` and record the inputs first.
+
+    Parameters
+    ----------
+    target : OutputTarget
+    ident : dict
+        From :func:`identity`.
+    force : bool
+        Replace results of other inputs.
+    results : list of str
+        Names of the files this command writes (a folder holding one of them without a record is
+        refused unless ``force``).
+    record : bool
+        Write the record (``complete: false``) now; ``False`` for a command that computes
+        everything before writing its first file: it calls :func:`begin` just before that.
+
+    Returns
+    -------
+    str
+        ``"new"``, ``"continue"`` (same inputs, earlier run interrupted), ``"again"`` (same
+        inputs, earlier run complete) or ``"replace"`` (``--force`` over other results).
+    """
+    folder = target.path
+    check_writable(target, folder=True)
+    old = read_record(folder) if folder.is_dir() else None
+    if old is not None:
+        diff = differences(old["identity"], ident)
+        if not diff:
+            state = "again" if old.get("complete") else "continue"
+        elif force:
+            state = "replace"
+        else:
+            raise refuse_different(target, diff)
+    else:
+        existing = [name for name in results if (folder / name).exists()]
+        if existing and not force:
+            raise OutputInUse(target.label, f"holds earlier results ({existing[0]}) whose "
+                                            "inputs are not recorded (no inputs.json)",
+                              "pass --force to replace them, or choose another output with "
+                              "--out")
+        state = "replace" if existing else "new"
+    if record:
+        begin(target, ident)
+    return state
+
+
+def begin(target: OutputTarget, ident: dict[str, Any]) -> None:
+    """Write the inputs record with ``complete: false`` (before the first result file)."""
+    _write_record(target.path, {"identity": ident, "complete": False})
+
+
+def mark_complete(target: OutputTarget, ident: dict[str, Any], lookups: list[dict] | None = None,
+                  **extra: Any) -> None:
+    """Rewrite the record with ``complete: true`` (the last write of a command)."""
+    record: dict[str, Any] = {"identity": ident, "complete": True, **extra}
+    if lookups is not None:
+        record["cache"] = cache_summary(lookups)
+    _write_record(target.path, record)
+
+
+def cache_summary(lookups: list[dict]) -> dict[str, Any]:
+    """Cache hits and builds by kind, from :func:`geardyn.cache.record_lookups`."""
+    out: dict[str, Any] = {}
+    for item in lookups:
+        k = out.setdefault(item["kind"], {"hits": 0, "built": 0})
+        k["hits" if item["hit"] else "built"] += 1
+    return out
+
+
+def say_state(state: str, target: OutputTarget) -> None:
+    """One line on stderr saying what a re-run does with the earlier results."""
+    from rich.markup import escape
+
+    from ._common import err_console
+
+    where = escape(str(target.path))
+    text = {"continue": f"continuing the interrupted run in {where} (same inputs)",
+            "again": f"same inputs as the results in {where}: running again (the cache makes it "
+                     "fast)",
+            "replace": f"--force: replacing the earlier results in {where}"}.get(state)
+    if text:
+        err_console.print(f"[dim]{text}[/dim]", highlight=False, soft_wrap=True)
+
+
+def say_cache(lookups: list[dict]) -> None:
+    """One line on stderr: what came from the cache and what was computed."""
+    from ._common import err_console
+
+    summary = cache_summary(lookups)
+    if summary:
+        parts = [f"{kind} {v['hits']} reused / {v['built']} computed" for kind, v in
+                 sorted(summary.items())]
+        err_console.print(f"[dim]cache: {'; '.join(parts)}[/dim]", highlight=False, soft_wrap=True)
+
+
+def _write_record(folder: Path, record: dict[str, Any]) -> None:
+    from ..io import write_json_atomic
+
+    folder.mkdir(parents=True, exist_ok=True)
+    write_json_atomic(folder / RECORD, record)

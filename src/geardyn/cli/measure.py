@@ -1,0 +1,97 @@
+"""``geardyn measure``: simulate a case and write what a housing accelerometer and a tachometer
+record (NetCDF, optionally CSV and .mat)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from . import app
+from ._common import (
+    ConfigOption,
+    ForceOption,
+    SetOption,
+    console,
+    err_console,
+    handle_errors,
+    load_case_from_cli,
+    progress_bar,
+    refuse_overwrite,
+)
+
+
+@app.command("measure")
+@handle_errors
+def measure(
+    config: ConfigOption = None,
+    set_: SetOption = None,
+    model: Annotated[str | None, typer.Option(
+        "--model", "-m", help="I or II (default: the case's simulation.model).",
+        show_default=False)] = None,
+    crack: Annotated[bool, typer.Option("--crack/--no-crack",
+                                        help="Include the case's tooth crack in the stiffness.")
+                     ] = True,
+    out: Annotated[Path, typer.Option("--out", "-o", help="Output NetCDF file.")
+                   ] = Path("measurement.nc"),
+    csv: Annotated[bool, typer.Option("--csv", help="Also write a CSV file beside it.")] = False,
+    mat: Annotated[bool, typer.Option("--mat", help="Also write a MATLAB .mat file beside it.")
+                   ] = False,
+    stiffness: Annotated[str | None, typer.Option(
+        "--stiffness", help="Mesh stiffness method: pem or fe (default: the case's).",
+        show_default=False)] = None,
+    force: ForceOption = False,
+) -> None:
+    """Simulate the gear pair, pass the bearing forces through the case's measurement chain
+    (housing modes, accelerometer, anti-alias filter, sampling, noise, ADC, tachometer) and write
+    the record (case.simulation.record_time long) to OUT."""
+    from ..errors import InputError
+    from ..measurement.record import write_csv, write_mat, write_netcdf
+    from ..stiffness import build_map
+    from ..studies.measure import chain_from_config
+    from ..studies.measure import measure as run_measure
+
+    case = load_case_from_cli(config, set_)
+    which = case.simulation.model if model is None else model.strip().upper()
+    if which not in ("I", "II"):
+        raise InputError("--model", model, "I or II")
+    if stiffness is not None and stiffness not in ("pem", "fe"):
+        raise InputError("--stiffness", stiffness, "'pem' or 'fe'")
+    if out.exists() and out.is_dir():
+        raise InputError("--out", str(out), "a file path (it is a folder)")
+    targets = [out] + ([out.with_suffix(".csv")] if csv else []) \
+        + ([out.with_suffix(".mat")] if mat else [])
+    refuse_overwrite(targets, force)
+    chain_from_config(case.measurement)  # bad chain settings fail before the simulation
+    with progress_bar() as bar:
+        task = bar.add_task("stiffness map", total=None)
+
+        def tick(done: int, total: int) -> None:
+            bar.update(task, completed=done, total=total)
+
+        smap = build_map(case, method=stiffness, cracked=crack, progress=tick)
+        bar.update(task, description=f"model {which}", completed=0, total=None)
+        result = run_measure(case, smap, model=which, cracked=crack, progress=tick)
+    ds = result.record
+    write_netcdf(ds, out)
+    written = [str(out)]
+    if csv:
+        write_csv(ds, out.with_suffix(".csv"))
+        written.append(str(out.with_suffix(".csv")))
+    if mat:
+        write_mat(ds, out.with_suffix(".mat"))
+        written.append(str(out.with_suffix(".mat")))
+    m = result.measured
+    console.print(f"[green]done[/green]: {m.acc.size} samples at {m.fs:.6g} Hz "
+                  f"({m.acc.size / m.fs:.4g} s), {m.pulse_times.size} tachometer pulses -> "
+                  f"{', '.join(written)}")
+    console.print(f"  acceleration RMS {float(m.acc.std()):.4g} m/s^2 "
+                  f"({float(m.acc.std()) / 9.80665:.4g} g), noise RMS {m.noise_rms:.4g} m/s^2")
+    if m.clipped:
+        err_console.print(f"[yellow]warning[/yellow]: the ADC clipped {m.clipped} samples "
+                          f"({100 * m.clipped / m.acc.size:.3g} %): raise measurement.adc_range")
+    console.print(f"  diagnose it: geardyn diagnose {out} --signal acc --tach tach --teeth "
+                  f"{case.pinion.teeth if result.chain.tach.shaft == 'pinion' else case.gear.teeth}"
+                  + (f" --pulses-per-rev {result.chain.tach.pulses_per_rev}"
+                     if result.chain.tach.pulses_per_rev > 1 else ""))

@@ -1,0 +1,97 @@
+"""What a run of the paper's case study produced, and how it reports progress.
+
+The study (:mod:`.paper`) fills a :class:`StudyResult`; the report (:mod:`.paper_report`) reads
+it. Neither this module nor the report imports the study.
+
+Progress protocol
+-----------------
+``progress(stage, done, total)``: three positional arguments, unchanged from earlier versions.
+
+* Announcements: ``(name, i, 5)`` as stage ``name`` (``"geometry"``, ``"stiffness"``,
+  ``"simulation"``, ``"diagnostics"``, ``"report"``: the names of ``paper.STAGES``) starts, ``i``
+  stages having finished; ``("done", 5, 5)`` at the end.
+* Counts: ``("<bar>: <item>", done, total)`` or ``("<bar>", done, total)``, one bar per ``<bar>``
+  with its own count that runs from 0 to ``total`` and is never reused for another count; the
+  text after ``": "`` names the item in progress. Bars: ``"stiffness (healthy)"`` and
+  ``"stiffness (cracked)"`` (the map builder's own count: FE solves or PEM grid lines; one step
+  when the map comes from the cache), ``"simulation"`` (5 records: model I and II, cracked and
+  healthy, and model II with the paper's start-of-step scheme), ``"diagnostics"`` (4 records)
+  and ``"report"`` (figures, then the files). A count call always carries an item when its
+  ``total`` equals the number of stages, so it cannot be mistaken for an announcement.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+__all__ = ["StudyResult", "Progress"]
+
+Progress = Callable[[str, int, int], None]
+
+
+@dataclass
+class StudyResult:
+    """What a study run produced.
+
+    Attributes
+    ----------
+    out : Path
+        Output folder.
+    summary : dict
+        The content of ``summary.json``.
+    stages : list of str
+        Stages completed.
+    seconds : dict of str -> float
+        Wall time per stage [s].
+    maps : dict
+        ``"healthy"``, ``"cracked"``: :class:`~geardyn.stiffness.map.StiffnessMap`.
+    figures : dict
+        Figure name -> :class:`matplotlib.figure.Figure`.
+    notes : list of str
+        Warnings to show in the report.
+    progress : callable, optional
+        See the module docstring.
+    quick : bool
+        Shorter records.
+    sims : dict
+        ``(model, state)`` -> simulation Dataset.
+    diagnoses : dict
+        ``(model, state)`` -> diagnosis result.
+    crack_angle_rad : float, optional
+        Pinion angle of the largest stiffness loss [rad].
+    paper_case : bool
+        Whether the case's inputs are the paper's (only then is it compared with the paper).
+    differences : list of dict
+        Physical inputs that differ from the paper's case (``key``, ``paper``, ``case``).
+    files : dict of str -> Path
+        Files written, by role.
+    """
+
+    out: Path
+    summary: dict = field(default_factory=dict)
+    stages: list[str] = field(default_factory=list)
+    seconds: dict[str, float] = field(default_factory=dict)
+    maps: dict = field(default_factory=dict)
+    figures: dict = field(default_factory=dict)
+    notes: list[str] = field(default_factory=list)
+    progress: Progress | None = None
+    quick: bool = False
+    sims: dict = field(default_factory=dict)
+    diagnoses: dict = field(default_factory=dict)
+    crack_angle_rad: float | None = None
+    paper_case: bool = True
+    differences: list = field(default_factory=list)
+    files: dict = field(default_factory=dict)
+
+    def emit(self, stage: str, done: int, total: int) -> None:
+        """Report progress (see the module docstring); a no-op without a callback."""
+        if self.progress is not None:
+            self.progress(stage, done, total)
+
+    def sub_progress(self, stage: str) -> Callable[[int, int], None] | None:
+        """A ``progress(done, total)`` callback reporting under ``stage``."""
+        if self.progress is None:
+            return None
+        return lambda done, total: self.emit(stage, done, total)

@@ -1,0 +1,162 @@
+"""Running a command twice into the same output just works; different inputs are refused in
+those words (issue 13: re-running and resuming).
+
+Each output records the identity of its inputs (``inputs.json`` in a folder, the
+``geardyn_inputs`` attribute of a ``simulate`` record); a re-run compares it. Cache use is read
+from the record's cache-hit counts, never from wall time.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+GEARDYN = [sys.executable, "-m", "geardyn"]
+SMALL = ["--set", "stiffness.centre_distances=6", "--set", "stiffness.nodes_per_segment=8"]
+SHORT_SIM = ["--set", "simulation.settle_time=0.002", "--set", "simulation.record_time=0.004",
+             "--stiffness", "pem", *SMALL]
+RUN = ["--quick", "--stiffness", "pem", "--set", "simulation.record_time=0.2 s",
+       "--set", "simulation.settle_time=0.05 s", "--set", "stiffness.centre_distances=11",
+       "--set", "diagnostics.samples_per_rev=1024"]
+
+
+def run(*args, cache, cwd=None, **extra_env):
+    env = {**os.environ, "GEARDYN_CACHE_DIR": str(cache), **extra_env}
+    return subprocess.run(GEARDYN + list(args), capture_output=True, text=True, env=env,
+                          cwd=cwd, timeout=1200)
+
+
+def _one_error_line(r):
+    assert r.returncode == 2, r.stdout + r.stderr
+    assert "Traceback" not in r.stdout + r.stderr
+    lines = [ln for ln in r.stderr.splitlines() if ln.strip()]
+    assert len(lines) == 1 and len(lines[0]) < 500, r.stderr
+    return lines[0]
+
+
+@pytest.mark.slow
+@pytest.mark.timeout(3600)  # two runs of the pipeline; minutes each on a loaded 2-core machine
+def test_run_twice_in_the_default_folder_then_other_inputs_refused(tmp_path):
+    """The README's command twice in a row in one folder: the second run exits 0 and takes every
+    stiffness map and simulation from the cache (the record says so); other inputs into the same
+    default folder are refused, naming the default folder (not --out) and what differs."""
+    cache = tmp_path / "cache"
+    first = run("run", *RUN, cache=cache, cwd=tmp_path, GEARDYN_PROGRESS="1", COLUMNS="80")
+    assert first.returncode == 0, first.stderr
+    # progress: one bar per stage, each ending on its own full count, no line over 80 columns
+    bars = [ln for ln in re.split(r"[\r\n]", re.sub(r"\x1b\[[0-9;?]*[A-Za-z]", "", first.stderr))
+            if "━" in ln]
+    assert bars and all(len(ln) <= 80 for ln in bars)
+    final = {ln.split("━")[0].strip(): ln.split("━")[-1].split()[0] for ln in bars}
+    assert final["run: simulation"] == "5/5" and final["run: diagnostics"] == "4/4"
+    assert {"run: stiffness (healthy)", "run: stiffness (cracked)", "run: report"} <= set(final)
+    out = tmp_path / "geardyn-out"
+    rec1 = json.loads((out / "inputs.json").read_text())
+    assert rec1["complete"] is True and rec1["identity"]["command"] == "run"
+    second = run("run", *RUN, cache=cache, cwd=tmp_path)
+    assert second.returncode == 0, second.stderr
+    assert "same inputs" in second.stderr
+    rec2 = json.loads((out / "inputs.json").read_text())
+    assert rec2["complete"] is True
+    assert rec2["cache"]["stiffness"] == {"hits": 2, "built": 0}
+    assert rec2["cache"]["simulation"]["built"] == 0 and rec2["cache"]["simulation"]["hits"] >= 5
+    a = json.loads((out / "summary.json").read_text())
+    assert a["complete"] is True
+    other = run("run", *RUN, "--set", "simulation.record_time=0.25 s", cache=cache, cwd=tmp_path)
+    line = _one_error_line(other)
+    assert "the default output folder geardyn-out holds results of different inputs" in line
+    assert "simulation.record_time 0.2 -> 0.25" in line
+    assert not line.startswith("error: --out")
+    # --force keeps its meaning
+    assert "--force" in line
+
+
+def test_folder_with_unrecorded_results_is_refused(tmp_path):
+    out = tmp_path / "old"
+    out.mkdir()
+    (out / "summary.json").write_text("{}")
+    r = run("run", "--out", str(out), *RUN, cache=tmp_path / "c")
+    line = _one_error_line(r)
+    assert f"--out {out} holds earlier results (summary.json) whose inputs are not recorded" in line
+    assert not (out / "inputs.json").exists()
+
+
+@pytest.mark.slow
+def test_stiffness_twice_into_one_folder_uses_the_cache(tmp_path):
+    out = tmp_path / "k"
+    cache = tmp_path / "c"
+    r1 = run("stiffness", "--method", "pem", "--out", str(out), *SMALL, cache=cache)
+    assert r1.returncode == 0, r1.stderr
+    assert json.loads((out / "inputs.json").read_text())["cache"]["stiffness"] == \
+        {"hits": 0, "built": 2}
+    r2 = run("stiffness", "--method", "PEM", "--out", str(out), *SMALL, cache=cache)
+    assert r2.returncode == 0, r2.stderr
+    rec = json.loads((out / "inputs.json").read_text())
+    assert rec["complete"] is True and rec["cache"]["stiffness"] == {"hits": 2, "built": 0}
+    r3 = run("stiffness", "--method", "pem", "--out", str(out), *SMALL,
+             "--set", "crack.depth=3mm", cache=cache)
+    line = _one_error_line(r3)
+    assert f"--out {out} holds results of different inputs (crack.depth" in line
+
+
+@pytest.mark.slow
+def test_simulate_twice_is_up_to_date_and_other_inputs_are_refused(tmp_path):
+    out = tmp_path / "s.nc"
+    cache = tmp_path / "c"
+    r1 = run("simulate", "-o", str(out), *SHORT_SIM, cache=cache)
+    assert r1.returncode == 0, r1.stderr
+    before = (out.stat().st_ino, out.stat().st_mtime_ns)
+    r2 = run("simulate", "-o", str(out), *SHORT_SIM, cache=cache)
+    assert r2.returncode == 0, r2.stderr
+    assert "up to date" in r2.stderr and "model II" in r2.stdout
+    assert (out.stat().st_ino, out.stat().st_mtime_ns) == before  # not rewritten
+    r3 = run("simulate", "-o", str(out), "--model", "i", *SHORT_SIM, cache=cache)
+    line = _one_error_line(r3)
+    assert "holds results of different inputs (model 'II' -> 'I')" in line
+    r4 = run("simulate", "-o", str(out), "--model", "i", "--force", *SHORT_SIM, cache=cache)
+    assert r4.returncode == 0, r4.stderr
+
+
+def test_simulate_refuses_a_foreign_file(tmp_path):
+    out = tmp_path / "mine.nc"
+    out.write_bytes(b"not a record")
+    r = run("simulate", "-o", str(out), *SHORT_SIM, cache=tmp_path / "c")
+    line = _one_error_line(r)
+    assert "not a geardyn record" in line
+    assert out.read_bytes() == b"not a record"
+
+
+def _write_csv(path, seed):
+    t = np.linspace(0, 2, 40000, endpoint=False)
+    th = 2 * np.pi * 18 * t
+    x = np.cos(115 * th) + 0.01 * np.random.default_rng(seed).standard_normal(t.size)
+    np.savetxt(path, np.column_stack([t, th, x]), delimiter=",", header="t,angle,acc",
+               comments="")
+
+
+@pytest.mark.slow
+def test_diagnose_defaults_beside_each_input_and_reruns(tmp_path):
+    """Two files diagnosed one after the other each get their own folder (today the second is
+    refused: both went to geardyn-out/diagnose); the same command twice just works."""
+    cache = tmp_path / "c"
+    opts = ["--time", "t", "--angle", "angle", "--signal", "acc", "--no-figures",
+            "--set", "diagnostics.samples_per_rev=256"]
+    for name, seed in (("a.csv", 1), ("b.csv", 2)):
+        _write_csv(tmp_path / name, seed)
+        r = run("diagnose", str(tmp_path / name), *opts, cache=cache, cwd=tmp_path)
+        assert r.returncode == 0, r.stderr
+        stem = name.removesuffix(".csv")
+        assert (tmp_path / f"{stem}-diagnose" / "metrics.json").exists()
+    again = run("diagnose", str(tmp_path / "a.csv"), *opts, cache=cache, cwd=tmp_path)
+    assert again.returncode == 0, again.stderr
+    # the same folder for another file's results is refused
+    into_a = run("diagnose", str(tmp_path / "b.csv"), "--out", str(tmp_path / "a-diagnose"),
+                 *opts, cache=cache)
+    line = _one_error_line(into_a)
+    assert "holds results of different inputs" in line and "the content of FILE" in line

@@ -1,0 +1,84 @@
+"""``geardyn config show`` in the units written and ``config validate`` running every check that
+needs no simulation (issue 13)."""
+
+from __future__ import annotations
+
+import math
+import tomllib
+
+import pytest
+
+from geardyn.case_checks import check_case
+from geardyn.config import load_case, paper_case
+from geardyn.errors import InputError
+
+from ._cli import assert_clean_error, cli
+
+
+def _case(tmp_path, text, name="c.toml"):
+    p = tmp_path / name
+    p.write_text(text, encoding="utf-8")
+    return p
+
+
+def test_show_prints_values_as_written_with_si_beside():
+    r = cli("config", "show")
+    assert r.exit_code == 0, r.output
+    assert "0.3490658503988659" not in r.stdout  # was '0.3490658503988659 rad'
+    data = tomllib.loads(r.stdout)
+    pa = data["pair"]["pressure_angle"]
+    assert pa["value"] == "20 deg" and pa["si"] == "0.3490658504 rad"
+    assert pa["source"] == "paper Table 1" and pa["origin"] == "geardyn/cases/xue_howard.toml"
+    assert data["pair"]["module"] == {"value": "6 mm", "si": "0.006 m",
+                                      "source": "paper Table 1",
+                                      "origin": "geardyn/cases/xue_howard.toml"}
+    assert data["simulation"]["decimation"]["origin"] == "default"
+
+
+def test_show_output_loads_back_to_the_same_case(tmp_path):
+    r = cli("config", "show", "--set", "pinion.teeth=25", "--set", 'load.speed="1090 rpm"')
+    assert r.exit_code == 0, r.output
+    p = _case(tmp_path, r.stdout, "shown.toml")
+    again = load_case(p)
+    want = paper_case(["pinion.teeth=25", 'load.speed="1090 rpm"'])
+    assert again.model_dump(exclude={"provenance"}) == want.model_dump(exclude={"provenance"})
+    assert again.provenance["pinion.teeth"] == "--set"
+    assert again.load.speed == pytest.approx(1090 * 2 * math.pi / 60, rel=1e-15)
+
+
+def test_show_of_a_partial_file_marks_its_values(tmp_path):
+    p = _case(tmp_path, 'name = "rig"\n[pair]\npressure_angle = "25 deg"\n')
+    r = cli("config", "show", "--config", str(p))
+    assert r.exit_code == 0, r.output
+    data = tomllib.loads(r.stdout)
+    assert data["name"] == "rig"
+    assert data["pair"]["pressure_angle"]["value"] == "25 deg"
+    assert data["pair"]["pressure_angle"]["origin"] == str(p)
+    assert data["pair"]["module"]["origin"] == "geardyn/cases/xue_howard.toml"
+
+
+@pytest.mark.parametrize(("text", "field"), [
+    ('[crack]\ndepth = "50 mm"\n', "crack.depth"),                       # passed before
+    ('[crack]\ndepth = "50 mm"\n[stiffness]\nmethod = "pem"\n', "crack.depth"),
+    ('[stiffness.fe]\nmesh_size = "5 mm"\n', "stiffness.fe.mesh_size"),
+    ('[stiffness]\ncentre_distance_max = "10 mm"\n', "stiffness.centre_distance_max"),
+    ('[crack]\ntooth = 23\n', "crack.tooth"),
+    ('[simulation]\nsettle_time = "1e6 s"\n', "simulation.settle_time"),
+])
+def test_validate_runs_the_physical_checks(tmp_path, text, field):
+    p = _case(tmp_path, text)
+    assert_clean_error(cli("config", "validate", str(p)), field)
+
+
+def test_validate_accepts_the_paper_case_and_a_valid_partial_case(tmp_path):
+    check_case(paper_case())
+    p = _case(tmp_path, '[crack]\ndepth = "3 mm"\n')
+    r = cli("config", "validate", str(p))
+    assert r.exit_code == 0, r.output
+    assert "valid" in r.stdout
+
+
+def test_check_case_names_the_field():
+    with pytest.raises(InputError) as exc:
+        check_case(paper_case(['crack.depth="50 mm"']))
+    assert exc.value.field == "crack.depth"

@@ -1,0 +1,19 @@
+"""Shared pieces of the reliability tier: an in-process Dask cluster, private cache folders."""
+
+from __future__ import annotations
+
+import pytest
+
+
+@pytest.fixture(scope="module")
+def client():
+    """An in-process Dask cluster (threads): the scheduler and task code paths of a process
+    cluster, without the start-up time."""
+    from distributed import Client, LocalCluster
+
+    cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=False,
+                           dashboard_address=None)
+    cl = Client(cluster)
+    yield cl
+    cl.close()
+    cluster.close()
