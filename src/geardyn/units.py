@@ -133,13 +133,62 @@ def _registry():
     return pint.UnitRegistry(autoconvert_offset_to_baseunit=True)
 
 
+_G, _M, _S, _R = "gram", "meter", "second", "radian"
+_FORCE = ((_G, 1), (_M, 1), (_S, -2))
+_PRESSURE = ((_G, 1), (_M, -1), (_S, -2))
+#: pint's answers for the unit names of the shipped cases and the everyday ones, so that reading a
+#: case does not pay pint's import and registry set-up (about 0.75 s per command). Not a second
+#: unit system: ``tests/config/test_units.py`` asserts that every entry equals pint's answer, and
+#: any other name goes to pint.
+_KNOWN_UNITS: dict[str, tuple[float, tuple[tuple[str, float], ...], str]] = {
+    "m": (1.0, ((_M, 1),), "meter"), "meter": (1.0, ((_M, 1),), "meter"),
+    "mm": (1e-3, ((_M, 1),), "millimeter"), "cm": (1e-2, ((_M, 1),), "centimeter"),
+    "um": (1e-6, ((_M, 1),), "micrometer"), "km": (1e3, ((_M, 1),), "kilometer"),
+    "deg": (math.pi / 180, ((_R, 1),), "degree"), "degree": (math.pi / 180, ((_R, 1),), "degree"),
+    "rad": (1.0, ((_R, 1),), "radian"), "radian": (1.0, ((_R, 1),), "radian"),
+    "kg": (1e3, ((_G, 1),), "kilogram"), "g": (1.0, ((_G, 1),), "gram"),
+    "N": (1e3, _FORCE, "newton"), "kN": (1e6, _FORCE, "kilonewton"),
+    "Pa": (1e3, _PRESSURE, "pascal"), "MPa": (1e9, _PRESSURE, "megapascal"),
+    "GPa": (1e12, _PRESSURE, "gigapascal"),
+    "s": (1.0, ((_S, 1),), "second"), "second": (1.0, ((_S, 1),), "second"),
+    "ms": (1e-3, ((_S, 1),), "millisecond"), "us": (1e-6, ((_S, 1),), "microsecond"),
+    "Hz": (1.0, ((_S, -1),), "hertz"), "kHz": (1e3, ((_S, -1),), "kilohertz"),
+    "MHz": (1e6, ((_S, -1),), "megahertz"),
+    "rpm": (2 * math.pi / 60, ((_R, 1), (_S, -1)), "revolutions_per_minute"),
+    "rps": (2 * math.pi, ((_R, 1), (_S, -1)), "revolutions_per_second"),
+    "g_n": (9.80665, ((_M, 1), (_S, -2)), "standard_gravity"),
+    "percent": (0.01, (), "percent"), "%": (0.01, (), "percent"),
+}
+#: pint's root form of each dimension's target unit (asserted equal to pint in the same test).
+_KNOWN_TARGETS: dict[str, tuple[float, dict[str, float]]] = {
+    "length": (1.0, {_M: 1}), "angle": (1.0, {_R: 1}), "mass": (1e3, {_G: 1}),
+    "inertia": (1e3, {_G: 1, _M: 2}), "stiffness": (1e3, {_G: 1, _S: -2}),
+    "damping": (1e3, {_G: 1, _S: -1}),
+    "torsional stiffness": (1e3, {_G: 1, _M: 2, _S: -2, _R: -1}),
+    "torsional damping": (1e3, {_G: 1, _M: 2, _S: -1, _R: -1}),
+    "torque": (1e3, {_G: 1, _M: 2, _S: -2}), "pressure": (1e3, {_G: 1, _M: -1, _S: -2}),
+    "time": (1.0, {_S: 1}), "frequency": (1.0, {_S: -1}),
+    "angular velocity": (1.0, {_R: 1, _S: -1}),
+    "quadratic torque coefficient": (1e3, {_G: 1, _M: 2, _R: -2}),
+    "density": (1e3, {_G: 1, _M: -3}), "acceleration": (1.0, {_M: 1, _S: -2}),
+    "dimensionless": (1.0, {}),
+}
+
+
 @functools.lru_cache(maxsize=512)
 def _unit_root(name: str) -> tuple[float, tuple[tuple[str, float], ...], str] | None:
     """``(factor, root units, canonical name)`` of one unit name, or None if pint does not know it.
 
     The name is a single identifier (letters only, at most 30 characters), so pint's lookup is
-    bounded.
+    bounded. Everyday names come from :data:`_KNOWN_UNITS` (pint's own answers, tested).
     """
+    if name in _KNOWN_UNITS:
+        return _KNOWN_UNITS[name]
+    return _pint_unit_root(name)
+
+
+def _pint_unit_root(name: str) -> tuple[float, tuple[tuple[str, float], ...], str] | None:
+    """:func:`_unit_root` asked of pint."""
     ureg = _registry()
     try:
         unit = ureg.Unit(name)
@@ -154,6 +203,13 @@ def _unit_root(name: str) -> tuple[float, tuple[tuple[str, float], ...], str] | 
 
 @functools.lru_cache(maxsize=64)
 def _target_root(dimension: str) -> tuple[float, dict[str, float]]:
+    if dimension in _KNOWN_TARGETS:
+        return _KNOWN_TARGETS[dimension]
+    return _pint_target_root(dimension)
+
+
+def _pint_target_root(dimension: str) -> tuple[float, dict[str, float]]:
+    """The root form of a dimension's target unit, asked of pint."""
     ureg = _registry()
     root = (1.0 * ureg.Unit(DIMENSIONS[dimension].target)).to_root_units()
     return float(root.magnitude), dict(root.unit_items())

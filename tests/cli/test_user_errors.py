@@ -45,7 +45,7 @@ def _args(command, out, tmp_path):
     return [command, "--out", str(out), *PEM]
 
 
-@pytest.mark.parametrize("command", ["run", "stiffness", "diagnose"])
+@pytest.mark.parametrize("command", ["run", "stiffness", "simulate", "diagnose"])
 def test_out_that_is_an_existing_file_is_refused_first(tmp_path, command):
     out = tmp_path / "a-file"
     out.write_text("keep me")

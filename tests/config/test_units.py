@@ -180,3 +180,20 @@ def test_fuzzed_unit_strings_give_a_number_or_a_clean_error(text, dimension):
         assert exc.field == "f" and len(str(exc)) < 500
     else:
         assert math.isfinite(v) and abs(v) <= 1e30
+
+
+def test_the_everyday_unit_table_is_pints_answer():
+    """The start-up fast path (``_KNOWN_UNITS``, ``_KNOWN_TARGETS``) equals pint for every entry:
+    the table is pint's data, not a second unit system."""
+    import math
+
+    from geardyn import units as U
+
+    for name, (factor, root, canon) in U._KNOWN_UNITS.items():
+        p_factor, p_root, p_canon = U._pint_unit_root(name)
+        assert math.isclose(factor, p_factor, rel_tol=1e-15), name
+        assert (tuple(root), canon) == (p_root, p_canon), name
+    for dim, (factor, root) in U._KNOWN_TARGETS.items():
+        p_factor, p_root = U._pint_target_root(dim)
+        assert math.isclose(factor, p_factor, rel_tol=1e-15) and root == p_root, dim
+    assert set(U._KNOWN_TARGETS) == set(U.DIMENSIONS)

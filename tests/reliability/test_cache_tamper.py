@@ -147,3 +147,45 @@ def test_stale_temporary_files_are_removed_and_live_ones_kept(case, tmp_path):
     other.write_bytes(b"half")
     write_bytes_atomic(out / "result.nc", b"whole")
     assert not left.exists() and other.exists() and (out / "result.nc").read_bytes() == b"whole"
+
+
+def test_a_cracked_fe_body_copied_over_the_healthy_key_is_rebuilt(tmp_path):
+    """The FE body cache (influence coefficients) compares its stored inputs hash with the key.
+
+    Oracle: the healthy body built into an empty cache; the rebuilt entry equals it bit for bit.
+    """
+    import dataclasses
+
+    from geardyn.stiffness.fe import FESettings
+    from geardyn.stiffness.fe.mesh import CrackGeometry
+    from geardyn.stiffness.fe.model import body_influence, body_inputs
+
+    case = paper_case()
+    settings = dataclasses.replace(FESettings.from_case(case), flank_size=0.15e-3,
+                                   tooth_size=1.5e-3, body_size=6e-3, refined_teeth=3, n_points=8)
+    from geardyn.stiffness.fe.solve import ElasticMaterial
+
+    gear = case.gear_pair().pinion
+    mat = ElasticMaterial(float(case.material.youngs_modulus), float(case.material.poisson_ratio),
+                          settings.plane)
+    crack = CrackGeometry(depth=2e-3, angle=float(case.crack.angle))
+    clean, hit = body_influence(gear, mat, settings, None, cache=Cache(tmp_path / "clean", True))
+    assert not hit
+    cache = Cache(tmp_path / "tampered", enabled=True)
+    body_influence(gear, mat, settings, None, cache=cache)
+    cracked, _ = body_influence(gear, mat, settings, crack, cache=cache)
+    hkey = cache_key(body_inputs(gear, mat, settings, None))
+    ckey = cache_key(body_inputs(gear, mat, settings, crack))
+    assert (clean.inputs_hash, cracked.inputs_hash) == (hkey, ckey) and hkey != ckey
+    entry = cache.path("fe", hkey, ".npz")
+    shutil.copyfile(cache.path("fe", ckey, ".npz"), entry)
+    _sidecar(entry, hkey)
+    assert cache.valid(entry, hkey)  # the checksum alone cannot see it
+    again, hit = body_influence(gear, mat, settings, None, cache=cache)
+    assert not hit  # rebuilt, not served
+    assert again.inputs_hash == hkey
+    np.testing.assert_array_equal(again.H, clean.H)
+    np.testing.assert_array_equal(again.u, clean.u)
+    assert (again.load_offsets, again.read_offsets) == (clean.load_offsets, clean.read_offsets)
+    again2, hit2 = body_influence(gear, mat, settings, None, cache=cache)
+    assert hit2 and np.array_equal(again2.H, clean.H)

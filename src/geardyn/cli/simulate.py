@@ -85,6 +85,11 @@ def simulate(
     target = resolve(out, DEFAULT_OUT)
     out = target.path
     check_writable(target, folder=False)  # before loading anything heavy
+    old, complete = _recorded_identity(out) if out.exists() else (None, None)
+    if out.exists() and old is None and not force:  # refused before the case and the imports
+        raise OutputInUse(target.label, "is an existing file that is not a geardyn record "
+                                        "of known inputs", "pass --force to replace it, or "
+                                                          "choose another file with --out")
     case = load_case_from_cli(config, set_)
     which = model or case.simulation.model
     method = stiffness or case.stiffness.method
@@ -102,14 +107,9 @@ def simulate(
     mat_path = out.with_suffix(".mat")
     up_to_date = False
     if out.exists():
-        old, complete = _recorded_identity(out)
         diff = differences(old, ident) if old is not None else None
         if diff and not force:
             raise refuse_different(target, diff)
-        if old is None and not force:
-            raise OutputInUse(target.label, "is an existing file that is not a geardyn record "
-                                            "of known inputs", "pass --force to replace it, or "
-                                                              "choose another file with --out")
         up_to_date = diff == [] and complete == 1
     elif mat and mat_path.exists() and not force:
         raise OutputInUse(target.label, f"has no record but {mat_path} exists",

@@ -26,7 +26,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from ...errors import InputError
+from ...errors import DataFileError, InputError
 from ...geometry import Gear
 from .contact import BodyCompliance, PairContactModel, candidates
 from .mesh import CrackGeometry, MeshSettings, build_body_mesh
@@ -144,10 +144,17 @@ def body_influence(gear: Gear, material: ElasticMaterial, settings: FESettings,
         stats = {**inf.stats, "t_mesh": t_mesh, "t_total": time.perf_counter() - t0}
         return BodyInfluence(u=inf.u, load_offsets=inf.load_offsets,
                              read_offsets=inf.read_offsets, H=inf.H, half_width=inf.half_width,
-                             plane_modulus=inf.plane_modulus, stats=stats)
+                             plane_modulus=inf.plane_modulus, stats=stats, inputs_hash=key)
+
+    def load(path) -> BodyInfluence:
+        obj = BodyInfluence.load(path)
+        if obj.inputs_hash != key:  # content of other inputs under this key: the cache rebuilds
+            raise DataFileError(path, f"holds the influence coefficients of other inputs "
+                                      f"(inputs_hash {obj.inputs_hash!r}, expected {key!r})")
+        return obj
 
     return cache.get_or_build("fe", key, ".npz", build, save=lambda obj, p: obj.save(p),
-                              load=BodyInfluence.load)
+                              load=load)
 
 
 def _crack_of(case, cracked: bool) -> CrackGeometry | None:

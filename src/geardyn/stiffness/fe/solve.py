@@ -338,6 +338,9 @@ class BodyInfluence:
         ``E'`` of the body [Pa] (for the analytical local correction).
     stats : dict
         Mesh and timing figures (nodes, dofs, seconds).
+    inputs_hash : str
+        Cache key of the inputs these coefficients were computed for ("" when not cached); a
+        cache entry whose stored hash differs from its key is rebuilt.
     """
 
     u: np.ndarray
@@ -347,6 +350,7 @@ class BodyInfluence:
     half_width: float
     plane_modulus: float
     stats: dict = field(default_factory=dict)
+    inputs_hash: str = ""
 
     def save(self, path) -> None:
         """Write to ``.npz`` (no pickle)."""
@@ -354,7 +358,8 @@ class BodyInfluence:
         with open(path, "wb") as fh:
             np.savez(fh, u=self.u, load_offsets=np.asarray(self.load_offsets),
                      read_offsets=np.asarray(self.read_offsets), H=self.H,
-                     half_width=self.half_width, plane_modulus=self.plane_modulus, stats=stats)
+                     half_width=self.half_width, plane_modulus=self.plane_modulus, stats=stats,
+                     inputs_hash=np.array(self.inputs_hash))
 
     @classmethod
     def load(cls, path) -> BodyInfluence:
@@ -364,7 +369,8 @@ class BodyInfluence:
             return cls(u=d["u"].copy(), load_offsets=tuple(int(v) for v in d["load_offsets"]),
                        read_offsets=tuple(int(v) for v in d["read_offsets"]), H=d["H"].copy(),
                        half_width=float(d["half_width"]), plane_modulus=float(d["plane_modulus"]),
-                       stats=stats)
+                       stats=stats,
+                       inputs_hash=str(d["inputs_hash"]) if "inputs_hash" in d.files else "")
 
 
 def _isfloat(v) -> bool:

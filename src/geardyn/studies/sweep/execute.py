@@ -14,7 +14,6 @@ import socket
 import threading
 import time
 import uuid
-import warnings
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -22,6 +21,7 @@ from typing import Any
 
 import numpy as np
 
+from ..._thread_warnings import thread_warnings
 from ...config import Case
 from ...errors import DataFileError, InputError
 from .evaluate import Evaluator, GeardynEvaluator, Output
@@ -68,8 +68,7 @@ def _evaluate_one(base_case: Case, overrides: dict, evaluator: Evaluator, seed: 
                   outputs: Sequence[Output]) -> RunRecord:
     """One run, never raising: failures and warnings are recorded in the result."""
     t0 = time.perf_counter()
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
+    with thread_warnings() as caught:  # this thread's warnings only (threaded workers)
         try:
             case = base_case.with_overrides(overrides) if overrides else base_case
             values = _check_values_shapes(evaluator(case, int(seed)), outputs)
@@ -96,8 +95,7 @@ def _run_batch(ctx: _Context, chunk: int, items: list[tuple[int, dict, int]]) ->
 
 def _prepare_task(base_case: Case, evaluator: Evaluator, overrides: dict) -> str | None:
     """Build shared inputs (e.g. a stiffness map) once; a failure is left to the runs."""
-    with warnings.catch_warnings():  # the runs record them
-        warnings.simplefilter("ignore")
+    with thread_warnings():  # discarded: the runs record them
         try:
             evaluator.prepare(base_case.with_overrides(overrides) if overrides else base_case)
             return None
@@ -109,8 +107,7 @@ def _pilot_task(base_case: Case, evaluator: Evaluator, candidates: list[tuple[di
     """Evaluate the first run that succeeds twice; return (values, seconds of the 2nd)."""
     last = ""
     for overrides, seed in candidates:
-        with warnings.catch_warnings():  # the runs record them
-            warnings.simplefilter("ignore")
+        with thread_warnings():  # discarded: the runs record them
             try:
                 case = base_case.with_overrides(overrides) if overrides else base_case
                 evaluator(case, seed)  # warm: maps, compiled kernels
