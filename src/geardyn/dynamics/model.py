@@ -18,7 +18,7 @@ and the equations of motion ``M x'' + C x' + K x = F`` with
 * ``F = [T_in(theta_m'), 0, 0, 0, 0, -T_out(theta_out')]`` (eqs. 9 and 16).
 
 Eq. 13 of the paper writes ``q_stp`` in the gear equation; ``q_stg`` is meant (erratum 3 of
-``design/dynamics.md``); geardyn uses ``q_stg``. ``r_b1``, ``r_b2`` are the *base* radii (the
+``docs/verification/dynamics.md``); geardyn uses ``q_stg``. ``r_b1``, ``r_b2`` are the *base* radii (the
 paper's ``r_p``, ``r_g``; its Table 1 "base radius 129.7 mm" is their sum, erratum 1).
 
 Damping the paper does not give is set from modal damping ratios (the convention of the PHM-BGU
@@ -70,7 +70,7 @@ __all__ = [
 #: Fewest time steps per period of the highest natural frequency (and of the mesh) accepted.
 #: Average-acceleration Newmark is unconditionally stable, so this is an accuracy limit: its period
 #: error is ``(omega dt)^2 / 12``, 3.3 % at 10 steps a period; coarser steps distort the mode the
-#: tooth handovers excite most. ``design/dynamics.md`` recommends 15 or more.
+#: tooth handovers excite most. ``docs/verification/dynamics.md`` recommends 15 or more.
 MIN_STEPS_PER_PERIOD = 10
 
 _LAW_CODES = {"constant": 0, "linear": 1, "quadratic": 2, "table": 3, "induction": 4}
@@ -503,7 +503,7 @@ def static_equilibrium(model: DynamicModel, stiffness_map, *, which: str = "II",
     ``T_cp = T_in(w)``, ``N = (T_cp - q_stp w)/r_b1``, ``y_p = -N/k_yp``, ``y_g = N/k_yg``,
     ``p = N/k_mb(theta0, dd)`` (``dd`` from eq. 4 for model II, 0 for model I),
     ``theta_m - theta_p = T_cp/k_cp``, ``theta_g - theta_out = T_cg/k_cg`` with
-    ``T_cg = N r_b2 - q_stg w_g`` (``design/dynamics.md``).
+    ``T_cg = N r_b2 - q_stg w_g`` (``docs/verification/dynamics.md``).
 
     Parameters
     ----------

@@ -2,7 +2,7 @@ r"""ISO 6336-1 (method B) single stiffness ``c'`` and mesh stiffness ``c_gamma_a
 
 A reference for the level of any mesh stiffness computed by geardyn (or by a user). ISO gives one
 number per pair, not a curve against the pinion angle, and depends on the centre distance only
-through the contact ratio (trap T16 of ``design/stiffness.md``).
+through the contact ratio (trap T16 of ``docs/verification/stiffness.md``).
 
 .. math::
    q' = C_1 + \frac{C_2}{z_{n1}} + \frac{C_3}{z_{n2}} + C_4 x_1 + \frac{C_5 x_1}{z_{n1}}
@@ -24,7 +24,7 @@ References
 ----------
 ISO 6336-1:2006/2019, Calculation of load capacity of spur and helical gears - Part 1: Basic
 principles, introduction and general influence factors (tooth stiffness parameters c' and
-c_gamma_alpha; the formulas as collected in design/stiffness.md 4.3).
+c_gamma_alpha; the formulas as collected in docs/verification/stiffness.md 4.3).
 """
 
 from __future__ import annotations

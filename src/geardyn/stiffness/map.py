@@ -9,7 +9,7 @@ In a mesh cycle the number of pairs in contact changes twice: when a pair leaves
 (``s = s_end``, fixed) and when a new pair enters at the gear tip (``s = s_start(d)``, which moves
 with the centre distance). Blending two ``K(theta)`` curves tabulated at fixed ``theta`` for two
 centre distances therefore smears each step into two half-steps (erratum 6 of
-``design/dynamics.md``). geardyn instead splits each mesh cycle into its two contact zones,
+``docs/verification/dynamics.md``). geardyn instead splits each mesh cycle into its two contact zones,
 
 * zone A: from the exit handover ``a`` to the entry handover ``b(d)`` (``floor(eps)`` pairs),
 * zone B: from ``b(d)`` to the next exit handover ``a + Theta_m`` (``ceil(eps)`` pairs),

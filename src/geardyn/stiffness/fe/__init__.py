@@ -24,7 +24,7 @@ per position" baseline of the benchmark.
 Basis of the numbers: plane strain by default (``[stiffness.fe] plane = "stress"`` for plane
 stress), 2-D results per metre of width multiplied by the face width; secant ``K_t = T / dtheta``
 at the applied torque with the gear hub fixed and the torque on the pinion hub, so the torsion of
-both bodies down to their bores is included (trap T5 of design/stiffness.md);
+both bodies down to their bores is included (trap T5 of docs/verification/stiffness.md);
 ``k_mb = K_t / r_b1^2`` with the base radius (trap T6).
 
 Validation (tests/fe, benchmarks/bench_fe.py): the elasticity solver against the exact

@@ -17,7 +17,7 @@ correction of the local Hertzian deformation to the actual contact width, ``g_j`
 programme ``min 1/2 F^T C F + g^T F`` subject to ``F >= 0``, ``a^T F = T/b``, solved exactly by an
 active-set enumeration (at most five candidates), with a fixed-point iteration on the load-dependent
 local term. Then ``K_t = T / Delta theta`` (secant) and ``k_mb = K_t / r_b1^2`` with the *base*
-radius (traps T5 and T6 of design/stiffness.md).
+radius (traps T5 and T6 of docs/verification/stiffness.md).
 
 Kinematics and unloaded gaps
 ----------------------------

@@ -1,6 +1,6 @@
 r"""The finite-element mesh stiffness of a case: bodies, cache and evaluation of the map.
 
-Pipeline (design/stiffness.md section 3.3): mesh each gear body once (:mod:`.mesh`), factorise
+Pipeline (docs/verification/stiffness.md, section 3): mesh each gear body once (:mod:`.mesh`), factorise
 once and compute the flank influence coefficients under Hertzian patches (:mod:`.solve`), cache
 them on disk (``.npz``, keyed by a hash of every input), then at each pinion angle and centre
 distance solve the small compatibility problem of :mod:`.contact`. Bodies with the same geometry,

@@ -12,7 +12,7 @@ solved for many right-hand sides.
 Loads: a Hertzian pressure patch
 --------------------------------
 A point load on a plane body gives a logarithmically infinite displacement under it, so the
-compliance of a point-loaded mesh never converges (trap T21 of design/stiffness.md). Each load is
+compliance of a point-loaded mesh never converges (trap T21 of docs/verification/stiffness.md). Each load is
 instead a Hertzian (elliptical) pressure distribution over the flank,
 
 .. math:: p(\sigma) = \frac{2}{\pi b}\sqrt{1 - (\sigma - \sigma_c)^2/b^2},
