@@ -59,9 +59,20 @@ def test_run_twice_in_the_default_folder_then_other_inputs_refused(tmp_path):
     out = tmp_path / "geardyn-out"
     rec1 = json.loads((out / "inputs.json").read_text())
     assert rec1["complete"] is True and rec1["identity"]["command"] == "run"
+    report = (out / "report.html").read_bytes()
     second = run("run", *RUN, cache=cache, cwd=tmp_path)
     assert second.returncode == 0, second.stderr
-    assert "same inputs" in second.stderr
+    # complete results of the same inputs: up to date, nothing recomputed or rewritten, and the
+    # same summary printed
+    assert "up to date (same inputs" in second.stderr and "--force recomputes" in second.stderr
+    assert (out / "report.html").read_bytes() == report
+    assert json.loads((out / "inputs.json").read_text()) == rec1
+    assert "validation against the paper" in second.stdout and "report.html" in second.stdout
+    # a result file removed: the run is repeated (from the cache)
+    (out / "report.html").unlink()
+    third = run("run", *RUN, cache=cache, cwd=tmp_path)
+    assert third.returncode == 0, third.stderr
+    assert "same inputs" in third.stderr and (out / "report.html").is_file()
     rec2 = json.loads((out / "inputs.json").read_text())
     assert rec2["complete"] is True
     assert rec2["cache"]["stiffness"] == {"hits": 2, "built": 0}

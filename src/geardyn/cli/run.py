@@ -45,6 +45,8 @@ def run(
     force: ForceOption = False,
 ) -> None:
     """Reproduce the paper's case study (model I vs II, healthy and cracked) into OUT."""
+    from rich.markup import escape
+
     from ..run_limits import check_step_count
     from ._outputs import (
         check_writable,
@@ -52,7 +54,6 @@ def run(
         identity,
         mark_complete,
         resolve,
-        say_cache,
         say_state,
     )
 
@@ -66,12 +67,22 @@ def run(
 
     check_step_count(_simulation_case(case, quick).simulation)  # before the heavy imports
 
+    ident = identity("run", case, {"quick": quick})
+    if not force and _up_to_date(target.path, ident):
+        # same inputs, complete results: nothing to compute (--force recomputes)
+        import json
+
+        summary = json.loads((target.path / "summary.json").read_text())
+        err_console.print(f"[dim]{escape(target.label)} is up to date (same inputs, complete "
+                          "results); --force recomputes it[/dim]", highlight=False,
+                          soft_wrap=True)
+        _print_summary(summary, target.path)
+        return
     from ..cache import record_lookups
     from ..dynamics.newmark import check_bounded_work
     from ..studies.paper import STAGES, run_paper_study
 
     check_bounded_work(_simulation_case(case, quick))
-    ident = identity("run", case, {"quick": quick})
     state = claim_folder(target, ident, force=force, results=RESULTS)
     say_state(state, target)
     with progress_bar() as bar, record_lookups() as lookups:
@@ -79,11 +90,27 @@ def run(
         result = run_paper_study(case, target.path, quick=quick, progress=progress)
         progress.close()
     mark_complete(target, ident, lookups)
-    s = result.summary
+    _print_summary(result.summary, result.out, lookups)
+
+
+def _up_to_date(folder: Path, ident: dict) -> bool:
+    """True if ``folder`` holds complete results of exactly these inputs (every result file)."""
+    from ._outputs import differences, read_record
+
+    old = read_record(folder) if folder.is_dir() else None
+    return (old is not None and bool(old.get("complete"))
+            and differences(old["identity"], ident) == []
+            and all((folder / name).is_file() for name in RESULTS))
+
+
+def _print_summary(s: dict, out: Path, lookups: list | None = None) -> None:
+    """The terminal summary of a run: the headline table, validation, measurement, cache."""
     from rich.markup import escape
     from rich.table import Table
 
-    t = Table(title=f"geardyn run: {escape(str(result.out))}/", show_lines=False)
+    from ._outputs import say_cache
+
+    t = Table(title=f"geardyn run: {escape(str(out))}/", show_lines=False)
     for col in ("quantity", "geardyn", "paper"):
         t.add_column(col, justify="left" if col == "quantity" else "right")
     cr = s.get("contact_ratio", {})
@@ -103,13 +130,27 @@ def run(
     val = s.get("validation", [])
     failed = [v for v in val if not v["pass"]]
     console.print(f"validation against the paper: {len(val) - len(failed)}/{len(val)} within "
-                  f"tolerance; stages: {', '.join(result.stages)} "
-                  f"({sum(result.seconds.values()):.1f} s)")
+                  f"tolerance; stages: {', '.join(s.get('stages', []))} "
+                  f"({s.get('run_time_s', {}).get('total', float('nan')):.1f} s)")
     for v in failed:
         err_console.print(f"[yellow]outside tolerance[/yellow]: {escape(v['quantity'])}: "
                           f"geardyn {v['geardyn']:.4g}, paper {v['paper']:.4g}")
-    say_cache(lookups)
-    report = result.out / "report.html"
+    meas = s.get("measurement", {})
+    if "indicators" in meas:
+        h = meas["indicators"]["errors+noise"]["healthy"]
+        c = meas["indicators"]["errors+noise"]["cracked"]
+        seen = [k for k, r in meas["detections"]["errors+noise"].items() if r["detected"]]
+        console.print(f"realistic measurement (housing accelerometer, tooth errors, noise, "
+                      f"model {meas['model']}): FM4 healthy {h['FM4']:.3g} / cracked "
+                      f"{c['FM4']:.3g}, NA4* {h['NA4star']:.3g} / {c['NA4star']:.3g}, energy "
+                      f"ratio {h['EnergyRatio']:.3g} / {c['EnergyRatio']:.3g}; crack seen by: "
+                      f"{', '.join(seen) or 'none of the indicators'}")
+    elif "skipped" in meas:
+        err_console.print(f"[yellow]note[/yellow]: realistic-measurement section skipped: "
+                          f"{escape(meas['skipped'])}")
+    if lookups is not None:
+        say_cache(lookups)
+    report = out / "report.html"
     if report.exists():
         console.print(f"report: [bold]{escape(str(report))}[/bold] (self-contained; open it in "
                       "a browser)")
