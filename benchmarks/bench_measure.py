@@ -10,6 +10,9 @@ Rows (all measured in this run):
 * the chain alone (``MeasurementChain.measure`` on the simulated arrays).
 
 The stiffness map (PEM, the paper's crack) comes from geardyn's cache (built once before timing).
+A third row names the machine (CPU model, cores) and reports the 1-minute load average over the
+timed part (before and after), since the machine may be shared: the ratio to the bare simulation
+is the figure that travels between machines.
 
 Run: ``python benchmarks/run.py measure`` (``--quick`` for a 1 s record).
 """
@@ -25,6 +28,31 @@ import numpy as np
 from _common import Row, best_time
 
 ROOT = Path(__file__).resolve().parents[1]
+
+
+def machine() -> str:
+    """CPU model and logical cores of this machine (Linux /proc/cpuinfo; platform otherwise)."""
+    import os
+    import platform
+
+    name = platform.processor() or platform.machine()
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                name = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    return f"{name}, {os.cpu_count()} logical cores, Python {platform.python_version()}"
+
+
+def _load() -> float:
+    import os
+
+    try:
+        return os.getloadavg()[0]
+    except OSError:  # pragma: no cover - not on Linux
+        return float("nan")
 
 
 def run(quick: bool) -> list[Row]:
@@ -44,6 +72,7 @@ def run(quick: bool) -> list[Row]:
     short = case.with_overrides({"simulation.record_time": 0.01, "simulation.settle_time": 0.0})
     measure(short, smap)
     repeat = 1 if quick else 2
+    load0 = _load()
     t_sim = best_time(lambda: simulate(case, smap), repeat=repeat)
     holder = {}
 
@@ -61,6 +90,7 @@ def run(quick: bool) -> list[Row]:
                                               ds["omega_p"].values, record_time=record),
                         repeat=3)
     n = r.record.sizes["time"]
+    load1 = _load()
     target = 5.0 if not quick else 0.5
     return [
         Row(f"measure(): {record:g} s at 50 kHz, acc + tach ({n} samples), model II, "
@@ -68,4 +98,15 @@ def run(quick: bool) -> list[Row]:
             "simulate / measure)", t_sim, f"< {target:g} s", t_meas < target),
         Row(f"measurement chain alone on {forces.shape[1]} simulated samples", t_chain, "s",
             "measure() end to end", t_meas, "", None),
+        Row(f"machine: {machine()}; 1-min load average before the timing (baseline column) "
+            "and after it", load1, "load", "before", load0, "", None),
     ]
+
+
+if __name__ == "__main__":  # python benchmarks/bench_measure.py [--quick]
+    for row in run(quick="--quick" in sys.argv):
+        base = "" if row.baseline_value is None else \
+            f"; {row.baseline}: {row.baseline_value:.4g} {row.unit}"
+        ratio = "" if row.ratio is None or row.unit == "load" else f"; ratio {row.ratio:.3g}x"
+        met = "" if row.met is None else f"; target {row.target}: {'met' if row.met else 'NOT met'}"
+        print(f"{row.name}: {row.value:.4g} {row.unit}{base}{ratio}{met}")

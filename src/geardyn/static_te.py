@@ -2,7 +2,8 @@ r"""Loaded and unloaded static transmission error of a gear pair (what a single-
 measures), with or without tooth errors and relief.
 
 At pinion angle ``theta`` every pair ``j`` in contact has the stiffness ``k_j = s_j k_mb`` (the
-stiffness map's load share ``s_j`` and mesh stiffness, at the contact pattern's angle) and the
+stiffness map's load share ``s_j``, scaled so that the shares of the pairs in contact sum to 1 as
+in the dynamics, and mesh stiffness, at the contact pattern's angle) and the
 geometric error ``e_j`` (:mod:`geardyn.modifications`). With the gear held and the pinion loaded by
 the torque ``T`` (mesh force ``N = T / r_b1``), the static transmission error along the line of
 action is the mesh approach ``delta`` that solves
@@ -28,7 +29,8 @@ import numpy as np
 from .errors import InputError
 from .modifications import ToothModifications
 
-__all__ = ["static_transmission_error", "solve_approach", "static_te_of_case"]
+__all__ = ["static_transmission_error", "solve_approach", "static_te_of_case",
+           "static_te_curves", "fig_static_te"]
 
 
 def solve_approach(k: np.ndarray, e: np.ndarray, force: float) -> tuple[float, int]:
@@ -50,6 +52,20 @@ def solve_approach(k: np.ndarray, e: np.ndarray, force: float) -> tuple[float, i
         if m == n - 1 or delta <= e[m + 1]:
             return float(delta), m + 1
     return float(e[0]) if n else math.nan, 0
+
+
+def _normalised(s: np.ndarray) -> np.ndarray:
+    """Shares of the pairs in contact scaled to sum to 1 (equal shares if they sum to 0).
+
+    An FE map gives part of the load to a pair in extended contact past the end of the path
+    (``load_share_exiting``), which has no slot; the dynamics weight the slot pairs by
+    ``s_j / sum s`` (:mod:`geardyn.modifications`, ``f = sum_active s_j / sum s``), so that with
+    every pair loaded the mesh stiffness is ``k_mb``; the static TE does the same. PEM maps'
+    shares already sum to 1."""
+    tot = float(np.sum(s))
+    if not tot > 0.0:
+        return np.full(s.shape, 1.0 / max(s.size, 1))
+    return s / tot
 
 
 def static_transmission_error(stiffness_map, torque: float, *,
@@ -107,7 +123,8 @@ def static_transmission_error(stiffness_map, torque: float, *,
     loaded = np.empty(th.shape, dtype=np.int64)
     for i in range(th.size):
         m = pe["in_contact"][i]
-        te[i], loaded[i] = solve_approach(shares[i, m] * kmb[i], pe["e"][i, m], force)
+        te[i], loaded[i] = solve_approach(_normalised(shares[i, m]) * kmb[i], pe["e"][i, m],
+                                          force)
     ds = xr.Dataset(
         {"transmission_error": ("theta", te * 1e6, {
             "units": "um", "long_name": "static transmission error along the line of action "
@@ -140,3 +157,74 @@ def static_te_of_case(case, torque: float | None = None, *, cracked: bool = Fals
         ToothModifications.none(case.gear_pair())
     t = case.motor.torque if torque is None else torque
     return static_transmission_error(stiffness_map, t, modifications=mods, **kw)
+
+
+def static_te_curves(case, torque: float | None = None, *, cracked: bool = False,
+                     errors: bool = True, stiffness_map=None,
+                     centre_distance_change: float = 0.0, n: int = 2048):
+    """Unloaded and loaded static transmission error of a case in one Dataset.
+
+    :func:`static_te_of_case` at ``0`` and at ``torque`` (default the motor torque) [N m],
+    stacked along a ``torque`` coordinate [N m], with the case's provenance in the attributes
+    (what ``geardyn static-te`` writes).
+
+    Returns
+    -------
+    xarray.Dataset
+        The variables of :func:`static_transmission_error` over ``(torque, theta)``.
+    """
+    import xarray as xr
+
+    from ._version import __version__
+    from .config import case_to_toml
+
+    if stiffness_map is None:
+        from .stiffness import build_map
+
+        stiffness_map = build_map(case, cracked=cracked)
+    t = float(case.motor.torque if torque is None else torque)
+    parts = [static_te_of_case(case, tq, cracked=cracked, errors=errors,
+                               stiffness_map=stiffness_map,
+                               centre_distance_change=centre_distance_change, n=n)
+             for tq in (0.0, t)]
+    ds = xr.concat(parts, dim="torque", data_vars="all", coords="minimal",
+                   combine_attrs="drop_conflicts")
+    ds = ds.assign_coords(torque=("torque", [0.0, t], {"units": "N m",
+                                                        "long_name": "pinion torque"}))
+    ds.attrs.update({
+        "title": "static transmission error, unloaded and loaded (rigid single-flank tester)",
+        "case": case.name, "case_toml": case_to_toml(case),
+        "stiffness_method": str(stiffness_map.attrs.get("method", case.stiffness.method)),
+        "stiffness_cracked": int(bool(cracked)), "tooth_errors_included": int(bool(errors)),
+        "geardyn_version": __version__})
+    for k in ("torque", "torque_units", "mesh_force", "mesh_force_units"):
+        ds.attrs.pop(k, None)
+    return ds
+
+
+def fig_static_te(ds):
+    """Figure of :func:`static_te_curves`: the transmission error along the line of action
+    [um] against the pinion angle [deg], one line per torque.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(9.0, 4.2), layout="constrained")
+    ax = fig.subplots()
+    deg = np.degrees(ds["theta"].values)
+    for i, tq in enumerate(ds["torque"].values):
+        te = ds["transmission_error"].values[i]
+        ax.plot(deg, te, lw=0.9, label=f"{'unloaded' if tq == 0 else 'loaded'}, "
+                                       f"T = {tq:g} N m (p-p {np.ptp(te):.3g} um)")
+    ax.set_xlabel("pinion angle [deg]")
+    ax.set_ylabel("static TE along the line of action [um]")
+    ax.set_title(f"{ds.attrs.get('case', '')}: static transmission error "
+                 f"({ds.attrs.get('stiffness_method', '')} map, "
+                 f"{'with' if ds.attrs.get('tooth_errors_included') else 'without'} tooth "
+                 "errors)", fontsize=9)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    return fig

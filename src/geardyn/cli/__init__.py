@@ -57,7 +57,7 @@ def _optional(name: str) -> None:
             raise
 
 
-for _name in ("stiffness", "simulate", "diagnose", "sweep", "measure"):
+for _name in ("stiffness", "simulate", "diagnose", "sweep", "measure", "static_te"):
     _optional(_name)
 
 

@@ -23,7 +23,7 @@ from ..config import Case, MeasurementConfig
 from ..measurement import FRFTable, MeasurementChain, ModalPath, Mode, Sensor, Tachometer
 from ..measurement.chain import Measured
 
-__all__ = ["measure", "chain_from_config", "MeasureResult"]
+__all__ = ["measure", "chain_from_config", "housing_forces", "MeasureResult"]
 
 
 def chain_from_config(cfg: MeasurementConfig | None) -> MeasurementChain:
@@ -52,6 +52,19 @@ def chain_from_config(cfg: MeasurementConfig | None) -> MeasurementChain:
                       jitter=cfg.tach_jitter, offset=cfg.tach_offset, amplitude=cfg.tach_amplitude,
                       rise_time=cfg.tach_rise_time)
     return MeasurementChain(path=path, sensor=sensor, tach=tach, seed=cfg.seed)
+
+
+def housing_forces(case: Case, stiffness_map, ds) -> np.ndarray:
+    """Bearing forces on the housing [N], shape ``(2, n)`` (pinion, gear), of a simulation
+    record ``ds`` of ``case`` (paper eqs. 10, 12: ``k_y y + q_y y'`` with the case's bearing
+    stiffness and damping; :func:`geardyn.measurement.bearing_forces`)."""
+    from ..dynamics import DynamicModel
+    from ..measurement import bearing_forces
+
+    dyn = DynamicModel.from_case(case, stiffness_map)
+    fp = bearing_forces(ds["y_p"].values, ds["v_yp"].values, dyn.K0[1, 1], dyn.damping["q_yp"])
+    fg = bearing_forces(ds["y_g"].values, ds["v_yg"].values, dyn.K0[3, 3], dyn.damping["q_yg"])
+    return np.vstack([fp, fg])
 
 
 @dataclass
@@ -108,8 +121,7 @@ def measure(case: Case, stiffness_map=None, *, model: str | None = None, cracked
     """
     from .. import _version
     from ..config import case_to_toml
-    from ..dynamics import DynamicModel, simulate
-    from ..measurement import bearing_forces
+    from ..dynamics import simulate
     from ..measurement.record import to_dataset
 
     chain = chain_from_config(case.measurement)
@@ -123,11 +135,9 @@ def measure(case: Case, stiffness_map=None, *, model: str | None = None, cracked
     long_case = case.model_copy(update={"simulation": sim_cfg.model_copy(
         update={"record_time": length})})
     ds = simulate(long_case, stiffness_map, model=model, cracked=cracked, progress=progress)
-    dyn = DynamicModel.from_case(case, stiffness_map)
-    fp = bearing_forces(ds["y_p"].values, ds["v_yp"].values, dyn.K0[1, 1], dyn.damping["q_yp"])
-    fg = bearing_forces(ds["y_g"].values, ds["v_yg"].values, dyn.K0[3, 3], dyn.damping["q_yg"])
     shaft = "p" if chain.tach.shaft == "pinion" else "g"
-    m = chain.measure(ds["time"].values, np.vstack([fp, fg]), ds[f"theta_{shaft}"].values,
+    m = chain.measure(ds["time"].values, housing_forces(case, stiffness_map, ds),
+                      ds[f"theta_{shaft}"].values,
                       ds[f"omega_{shaft}"].values, record_time=sim_cfg.record_time)
     cfg = case.measurement if case.measurement is not None else MeasurementConfig()
     attrs = {

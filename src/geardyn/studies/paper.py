@@ -10,7 +10,11 @@ Stages run in order, each adding to the summary and to the output folder:
    is written to ``runs/model_<M>_<state>.nc``.
 4. ``diagnostics``: TSA, spectra, residual, PWVD, demodulation, statistics (Tables 2, 3) and
    condition metrics, healthy against cracked (Figs. 11-23).
-5. ``report``: ``report.html``, ``results.nc`` and ``figures/`` (:mod:`.paper_report`).
+5. ``measurement``: the same indicators on a realistic measurement (housing accelerometer
+   through the case's sensor chain, ISO 1328 tooth errors, noise, TSA from the tachometer), in
+   four variants that separate the errors from the noise (:mod:`.paper_measurement`); reuses
+   the maps and records, adds two cached simulations with tooth errors.
+6. ``report``: ``report.html``, ``results.nc`` and ``figures/`` (:mod:`.paper_report`).
 
 After each stage the consistency checks and the comparisons with the paper are recomputed from
 the summary (:mod:`.paper_validation`). Module layout, one way only: this pipeline imports the
@@ -425,6 +429,20 @@ def diagnostics_stage(case: Case, out: Path, result: StudyResult) -> None:
         F[f"fig{c}_analytic_{sig}"] = pf.fig_analytic_pair(cracked, sig)
 
 
+def measurement_stage(case: Case, out: Path, result: StudyResult) -> None:
+    """The paper's indicators on a realistic measurement (:mod:`.paper_measurement`)."""
+    from . import paper_figures as pf
+    from .paper_measurement import measurement_stage as run_stage
+
+    run_stage(case, _simulation_case(case, result.quick), result, simulate=cached_simulation)
+    m = result.summary["measurement"]
+    if "skipped" in m:
+        result.notes.append(f"Realistic-measurement section skipped: {m['skipped']}.")
+    elif result.measured_tsa:
+        result.figures["fig24_measured_tsa"] = pf.fig_measured_tsa(result.measured_tsa,
+                                                                   m["model"])
+
+
 def _report_stage(case: Case, out: Path, result: StudyResult) -> None:
     from .paper_report import report_stage
 
@@ -436,6 +454,7 @@ STAGES: list[tuple[str, Callable[[Case, Path, StudyResult], None]]] = [
     ("stiffness", stiffness_stage),
     ("simulation", simulation_stage),
     ("diagnostics", diagnostics_stage),
+    ("measurement", measurement_stage),
     ("report", _report_stage),
 ]
 

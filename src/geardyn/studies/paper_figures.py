@@ -13,7 +13,7 @@ from matplotlib.figure import Figure
 
 __all__ = ["SIGNALS", "fig8_design_parameters", "fig9_iteration", "fig10_stiffness",
            "fig_tsa", "fig_spectra", "fig_residuals", "fig_pwvd_pair", "fig_demodulation_pair",
-           "fig_analytic_pair", "crack_times"]
+           "fig_analytic_pair", "crack_times", "fig_measured_tsa"]
 
 #: The paper's three signals: name -> (label, unit, symbol)
 SIGNALS = {
@@ -279,4 +279,43 @@ def fig_analytic_pair(diags: dict, sig: str) -> Figure:
     ax.set_title(f"analytic signal of the demodulated harmonic: {SIGNALS[sig][0]}", fontsize=9)
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3)
+    return fig
+
+
+#: Variants of the measurement section drawn by :func:`fig_measured_tsa`: name -> (colour,
+#: line width, label).
+MEASURED_STYLE = {"ideal": ("black", 0.8, "ideal (no errors, no noise)"),
+                  "errors": ("#1f77b4", 0.8, "tooth errors only"),
+                  "errors+noise": ("#d62728", 0.6, "tooth errors + noise (realistic)")}
+
+
+def fig_measured_tsa(tsas: dict, model: str) -> Figure:
+    """TSA of the housing acceleration (tachometer TSA, in g) over one revolution of the
+    tachometer's shaft, healthy (top) and cracked (bottom), for the measurement variants of
+    :data:`MEASURED_STYLE` (:mod:`geardyn.studies.paper_measurement`).
+
+    Parameters
+    ----------
+    tsas : dict
+        ``(variant, state)`` -> TSA [m/s^2].
+    model : str
+        Model of the simulations (title).
+    """
+    g = 9.80665
+    fig = Figure(figsize=(11.0, 6.0), layout="constrained")
+    axs = fig.subplots(2, 1, sharex=True)
+    for ax, state in zip(axs, ("healthy", "cracked"), strict=True):
+        for name, (color, lw, label) in MEASURED_STYLE.items():
+            a = tsas.get((name, state))
+            if a is None:
+                continue
+            ang = np.arange(a.size) * 360.0 / a.size
+            ax.plot(ang, a / g, lw=lw, color=color, label=label)
+        ax.set_title(f"model {model}, {state}: TSA of the housing acceleration (tachometer)",
+                     fontsize=9)
+        ax.set_ylabel("acceleration [g]")
+        ax.grid(alpha=0.3)
+    axs[0].legend(fontsize=8, loc="upper right")
+    _deg_axis(axs[1])
+    axs[1].set_xlabel("shaft angle from the tachometer pulse [deg]")
     return fig

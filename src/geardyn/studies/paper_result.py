@@ -7,17 +7,19 @@ Progress protocol
 -----------------
 ``progress(stage, done, total)``: three positional arguments, unchanged from earlier versions.
 
-* Announcements: ``(name, i, 5)`` as stage ``name`` (``"geometry"``, ``"stiffness"``,
-  ``"simulation"``, ``"diagnostics"``, ``"report"``: the names of ``paper.STAGES``) starts, ``i``
-  stages having finished; ``("done", 5, 5)`` at the end.
+* Announcements: ``(name, i, 6)`` as stage ``name`` (``"geometry"``, ``"stiffness"``,
+  ``"simulation"``, ``"diagnostics"``, ``"measurement"``, ``"report"``: the names of
+  ``paper.STAGES``) starts, ``i`` stages having finished; ``("done", 6, 6)`` at the end.
 * Counts: ``("<bar>: <item>", done, total)`` or ``("<bar>", done, total)``, one bar per ``<bar>``
   with its own count that runs from 0 to ``total`` and is never reused for another count; the
   text after ``": "`` names the item in progress. Bars: ``"stiffness (healthy)"`` and
   ``"stiffness (cracked)"`` (the map builder's own count: FE solves or PEM grid lines; one step
   when the map comes from the cache), ``"simulation"`` (5 records: model I and II, cracked and
-  healthy, and model II with the paper's start-of-step scheme), ``"diagnostics"`` (4 records)
-  and ``"report"`` (figures, then the files). A count call always carries an item when its
-  ``total`` equals the number of stages, so it cannot be mistaken for an announcement.
+  healthy, and model II with the paper's start-of-step scheme), ``"diagnostics"`` (4 records),
+  ``"measurement"`` (10 steps: two simulations with tooth errors, then 8 measured records; 0
+  then 10 when the results come from the cache) and ``"report"`` (figures, then the files). A
+  count call always carries an item when its ``total`` equals the number of stages, so it
+  cannot be mistaken for an announcement.
 """
 
 from __future__ import annotations
@@ -67,6 +69,9 @@ class StudyResult:
         Physical inputs that differ from the paper's case (``key``, ``paper``, ``case``).
     files : dict of str -> Path
         Files written, by role.
+    measured_tsa : dict
+        ``(variant, state)`` -> TSA of the housing acceleration [m/s^2] over one revolution
+        (measurement stage, :mod:`.paper_measurement`).
     """
 
     out: Path
@@ -84,6 +89,7 @@ class StudyResult:
     paper_case: bool = True
     differences: list = field(default_factory=list)
     files: dict = field(default_factory=dict)
+    measured_tsa: dict = field(default_factory=dict)
 
     def emit(self, stage: str, done: int, total: int) -> None:
         """Report progress (see the module docstring); a no-op without a callback."""
