@@ -265,6 +265,40 @@ class CrackConfig(_Model):
                            "parallel to the centreline (Chen & Shao 2011).")
 
 
+class FaultConfig(_Model):
+    """One tooth fault of the ``faults`` list (geardyn.faults); which keys a type takes:
+    root_crack (depth, angle, limit_line, width, front, slices), spall (start and length, or
+    roll_start and roll_length, width, depth), breakage (height, width), wear (depth, start and
+    length or roll_start and roll_length, stiffness)."""
+
+    type: Literal["root_crack", "spall", "breakage", "wear"] = Field(
+        description="Fault type.")
+    gear: Literal["pinion", "gear"] = Field("pinion", description="Which gear has the fault.")
+    tooth: int = Field(0, ge=0, strict=True, description="Faulty tooth (0-based, mesh order).")
+    depth: Length | None = Field(None, description="Crack length, spall depth or wear depth [m].")
+    angle: Angle | None = Field(None, description="root_crack: angle to the tooth centreline "
+                                                  "[rad] (default 45 deg).")
+    limit_line: Literal["tip", "parallel"] | None = Field(None, description="root_crack: PEM "
+                                                          "limit line (default 'tip').")
+    width: Length | None = Field(None, description="Width across the face [m]: cracked width, "
+                                                   "spall width or broken width (default: the "
+                                                   "whole face for root_crack and breakage).")
+    front: Literal["uniform", "linear", "parabolic"] | None = Field(
+        None, description="root_crack: depth profile across the cracked width.")
+    slices: int | None = Field(None, strict=True, description="root_crack: slices across the "
+                                                               "cracked width (default 20).")
+    start: Length | None = Field(None, description="spall, wear: roll length of the lower edge "
+                                                   "from the base-circle tangency point [m].")
+    length: Length | None = Field(None, description="spall, wear: extent in roll length [m].")
+    roll_start: Angle | None = Field(None, description="spall, wear: roll angle of the lower "
+                                                       "edge [rad].")
+    roll_length: Angle | None = Field(None, description="spall, wear: extent in roll angle "
+                                                        "[rad].")
+    height: Length | None = Field(None, description="breakage: height lost from the tip [m].")
+    stiffness: bool | None = Field(None, description="wear: also thin the tooth in the PEM "
+                                                     "stiffness (default false).")
+
+
 class FEConfig(_Model):
     """Finite-element mesh stiffness settings."""
 
@@ -460,6 +494,8 @@ class Case(_Model):
     output_coupling: CouplingConfig
     mesh: MeshConfig = Field(default_factory=MeshConfig)
     crack: CrackConfig | None = None
+    faults: list[FaultConfig] = Field(default_factory=list, description="Tooth faults "
+                                      "(geardyn.faults): [[faults]] tables, any number.")
     modifications: ModificationsConfig | None = None
     stiffness: StiffnessConfig = Field(default_factory=StiffnessConfig)
     simulation: SimulationConfig = Field(default_factory=SimulationConfig)
@@ -849,14 +885,22 @@ def _set_dotted(data: dict, key: str, value: Any) -> None:
         raise InputError("--set", key, "a dotted key such as 'pinion.teeth'")
     node = data
     for i, p in enumerate(parts[:-1]):
+        if isinstance(node, list):  # an entry of a list of tables: faults.0.depth
+            if not p.isdigit() or int(p) >= len(node):
+                raise InputError(".".join(parts[: i + 1]), key,
+                                 f"an index in [0, {len(node) - 1}] of the list")
+            node = node[int(p)]
+            continue
         nxt = node.get(p)
         if nxt is None and (p in ("crack", "modifications", "measurement")
                             or parts[0] == "modifications"):
             nxt = node[p] = {}
-        if not isinstance(nxt, dict):
+        if not isinstance(nxt, dict | list):
             raise InputError(".".join(parts[: i + 1]), nxt if nxt is not None else key,
                              "an existing section of the case (see 'geardyn config show')")
         node = nxt
+    if isinstance(node, list):
+        raise InputError(key, value, "a key of one entry of the list, e.g. 'faults.0.depth'")
     node[parts[-1]] = value
 
 
@@ -956,6 +1000,10 @@ def _model_leaves(model: BaseModel, prefix: str = "") -> Iterator[tuple[str, Any
         key = f"{prefix}.{name}" if prefix else name
         if isinstance(value, BaseModel):
             yield from _model_leaves(value, key)
+        elif isinstance(value, list) and value and isinstance(value[0], BaseModel):
+            yield key, [v.model_dump(mode="json", exclude_none=True) for v in value]
+        elif name == "faults" and not value:
+            continue
         elif value is not None:
             yield key, value
 
@@ -963,9 +1011,14 @@ def _model_leaves(model: BaseModel, prefix: str = "") -> Iterator[tuple[str, Any
 def _validate(data: dict[str, Any], source: str = "") -> Case:
     """Validate plain case data, naming the first bad field as the user wrote it."""
     try:
-        return Case.model_validate(data)
+        case = Case.model_validate(data)
     except ValidationError as exc:
         raise _format_validation_error(exc, data) from None
+    if case.faults:  # geometry checks of the faults list (errors name faults[i].<key>)
+        from .faults import check_faults
+
+        check_faults(case)
+    return case
 
 
 @dataclass(frozen=True)
@@ -1113,6 +1166,10 @@ def _to_toml_tree(model: BaseModel, prov: Mapping[str, str], prefix: str = "") -
         if isinstance(value, BaseModel):
             out[name] = _to_toml_tree(value, prov, key)
             continue
+        if name == "faults" and not value:
+            continue  # no faults: the text of a case without them stays as it was
+        if isinstance(value, list) and value and isinstance(value[0], BaseModel):
+            value = [_to_toml_tree(v, {}, key) for v in value]  # [[faults]] tables
         dim = _dimension_of(type(model), name)
         if dim is not None and isinstance(value, float):
             value = format_si(value, dim)
@@ -1183,4 +1240,5 @@ def case_schema() -> str:
 
 def deep_copy_case_data(case: Case) -> dict[str, Any]:
     """Plain-Python copy of a case's values (SI floats), for hashing and serialisation."""
-    return copy.deepcopy(case.model_dump(mode="json", exclude={"provenance"}))
+    exclude = {"provenance"} | (set() if case.faults else {"faults"})  # as before faults
+    return copy.deepcopy(case.model_dump(mode="json", exclude=exclude))

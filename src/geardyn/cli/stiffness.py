@@ -40,7 +40,8 @@ DEFAULT_OUT = Path("geardyn-out/stiffness")
 
 #: Files this command writes (a folder holding one without an inputs record is not overwritten).
 RESULTS = ["stiffness_healthy.nc", "stiffness_cracked.nc", "fig5_stiffness.png",
-           "fig5_load_sharing.png", "fig6_crack.png", "fe_mesh.png"]
+           "fig5_load_sharing.png", "fig6_crack.png", "fe_mesh.png", "stiffness_faulty.nc",
+           "fig_faults.png"]
 
 
 @app.command("stiffness")
@@ -76,6 +77,11 @@ def stiffness(
     method = method or case.stiffness.method
     out = target.path
     has_crack = case.crack is not None and case.crack.enabled
+    has_faults = bool(getattr(case, "faults", None))  # the faults list: a "faulty" map
+    if has_faults:
+        from ..faults import check_method
+
+        check_method(case, method)  # before any map: the FE method refuses the faults list
     ident = identity("stiffness", case, {"method": method})
     state = claim_folder(target, ident, force=force, results=RESULTS, record=False)
 
@@ -91,8 +97,8 @@ def stiffness(
         # the maps carry their validity notes in attrs["warnings"]; printed below once
         warnings.simplefilter("ignore", UserWarning)
         progress = StageProgress(bar)
-        for name, cracked in (("healthy", False), ("cracked", True)):
-            if cracked and not has_crack:
+        for name, cracked in (("healthy", False), ("faulty" if has_faults else "cracked", True)):
+            if cracked and not (has_crack or has_faults):
                 continue
             label = f"{method} map, {name}"
             progress(label, 0, 0)  # visible at once (an FE mesh comes before any count)
@@ -111,6 +117,10 @@ def stiffness(
             "fig5_load_sharing.png": fig_load_sharing(maps["healthy"])}
     if "cracked" in maps:
         figs["fig6_crack.png"] = fig_crack(maps["healthy"], maps["cracked"])
+    if "faulty" in maps:
+        from ..faults.figures import fig_faults
+
+        figs["fig_faults.png"] = fig_faults(maps["healthy"], maps["faulty"])
     if method == "fe":
         from ..stiffness.fe import plot_mesh
 
@@ -139,13 +149,16 @@ def stiffness(
     notes = sorted({w for m in maps.values() for w in _map_warnings(m)})
     for w in notes:
         err_console.print(f"[yellow]note[/yellow]: {w}", highlight=False)
-    if not has_crack:
+    if not has_crack or has_faults:
         for stale in ("stiffness_cracked.nc", "fig6_crack.png"):  # from earlier inputs (--force)
+            (out / stale).unlink(missing_ok=True)
+    if not has_faults:
+        for stale in ("stiffness_faulty.nc", "fig_faults.png"):
             (out / stale).unlink(missing_ok=True)
     if method != "fe":
         (out / "fe_mesh.png").unlink(missing_ok=True)
     mark_complete(target, ident, lookups)
     say_cache(lookups)
-    if not has_crack:
+    if not has_crack and not has_faults:
         console.print("no enabled crack in the case: only the healthy map and Fig. 5 written")
     console.print(f"[green]wrote[/green] {', '.join(written)} -> {out}/")

@@ -44,6 +44,9 @@ def map_inputs(case, method: str, cracked: bool) -> dict:
         "crack": case.crack.model_dump(mode="json") if (cracked and case.crack is not None
                                                         and case.crack.enabled) else None,
     }
+    if cracked and getattr(case, "faults", None):  # only then: earlier keys stay valid
+        data["faults"] = [f.model_dump(mode="json") for f in case.faults]
+        data["faults_version"] = "1"
     if method == "fe":
         data["fe"] = case.stiffness.fe.model_dump(mode="json")
     else:
@@ -64,7 +67,9 @@ def build_map(case, *, method: str | None = None, cracked: bool = True,
     method : {"pem", "fe"}, optional
         Default: ``case.stiffness.method``.
     cracked : bool
-        Include the case's crack (if it has an enabled one); ``False`` gives the healthy map.
+        Include the case's crack (if it has an enabled one) and its ``faults`` list; ``False``
+        gives the healthy map. The FE method refuses a case with a ``faults`` list
+        (:func:`geardyn.faults.check_method`).
     progress : callable, optional
         ``progress(done, total)``.
     cache : geardyn.cache.Cache, optional
@@ -82,6 +87,10 @@ def build_map(case, *, method: str | None = None, cracked: bool = True,
     method = method or case.stiffness.method
     if method not in MODEL_VERSIONS:
         raise InputError("stiffness.method", method, "'pem' or 'fe'")
+    if cracked:  # a method that cannot model a fault of the case says so (geardyn.faults)
+        from ..faults import check_method
+
+        check_method(case, method)
     cache = cache or default_cache()
     inputs = map_inputs(case, method, cracked)
     key = cache_key(inputs)

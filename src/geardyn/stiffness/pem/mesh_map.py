@@ -21,6 +21,27 @@ CITATIONS = (
 )
 
 
+#: Sources of the fault terms (geardyn.faults): what was read, and what could not be.
+FAULT_CITATIONS = (
+    "PHM-BGU gear model (MATLAB, Ben-Gurion University 2023), calcKeq.m and "
+    "calcInvBendingStiff.m (spall and breakage as lost contact width; read)",
+    "Chaari, Baccar, Abbes & Haddar 2008, Eur. J. Mech. A/Solids 27:691-705 (spalling and tooth "
+    "breakage; not read)",
+    "Chen & Shao 2011, Eng. Fail. Anal. 18:2149-2164 (crack along the tooth width, slicing; "
+    "not read)",
+)
+
+
+def _case_faults(case) -> tuple:
+    """The case's validated faults when it has a ``faults`` list, else ``()`` (the ``[crack]``
+    section alone keeps the original model, bit for bit)."""
+    if not getattr(case, "faults", None):
+        return ()
+    from ...faults import faults_from_case
+
+    return faults_from_case(case)
+
+
 def pem_map(case, dd: np.ndarray, *, cracked: bool,
             progress: Callable[[int, int], None] | None = None,
             model: str = "exact") -> StiffnessMap:
@@ -52,7 +73,13 @@ def pem_map(case, dd: np.ndarray, *, cracked: bool,
         ``attrs["warnings"]`` as well; informational notes, such as ``theta_f`` beyond the
         unsourced ``[0.01, 0.12]`` rad box, go to ``attrs["notes"]`` only).
     """
-    pem = PEMModel.from_case(case, cracked=cracked, model=model)
+    faults = _case_faults(case) if cracked else ()
+    if faults:  # the faults list (geardyn.faults): the fault model
+        from .fault_model import fault_model_from_case
+
+        pem = fault_model_from_case(case, faults, model=model)
+    else:
+        pem = PEMModel.from_case(case, cracked=cracked, model=model)
     dd = np.atleast_1d(np.asarray(dd, float))
     pem.check_range(dd)
     notes = pem.validity_warnings()
@@ -62,11 +89,16 @@ def pem_map(case, dd: np.ndarray, *, cracked: bool,
     n_cycles = None
     if pem.crack is not None and pem.crack.gear == "gear":
         n_cycles = pem.pair.gear.teeth
+    if faults:
+        n_cycles = pem.period_cycles
 
     def fn(theta: np.ndarray, d: float) -> dict:
         r = pem.evaluate(theta, d)
-        return {"k_mb": r["k_mb"], "load_share": r["load_share"],
-                "pairs_in_contact": r["pairs_in_contact"].astype(float)}
+        out = {"k_mb": r["k_mb"], "load_share": r["load_share"],
+               "pairs_in_contact": r["pairs_in_contact"].astype(float)}
+        if "fault_gap" in r:
+            out["fault_gap"] = r["fault_gap"]
+        return out
 
     from ..._version import __version__
 
@@ -81,6 +113,10 @@ def pem_map(case, dd: np.ndarray, *, cracked: bool,
         "geardyn_version": __version__,
         "case": case.name,
     }
+    if faults:
+        attrs["cracked"] = int(bool(pem.active))
+        attrs["faulty"] = int(bool(pem.active))
+        attrs["citations"] = list(CITATIONS) + list(FAULT_CITATIONS)
     return StiffnessMap.from_function(pem.pair, dd, fn, n_cycles=n_cycles,
                                       n_seg=case.stiffness.nodes_per_segment, attrs=attrs,
                                       progress=progress)

@@ -41,7 +41,14 @@ def _case_field(key: str, where: str) -> _CaseField:
     """Resolve a dotted case key to its leaf field, or raise InputError naming ``where``."""
     parts = key.split(".")
     model: type[BaseModel] = Case
+    item: type[BaseModel] | None = None  # the model of a list entry (faults.0.depth)
     for i, p in enumerate(parts):
+        if item is not None:
+            if not p.isdigit() or i == len(parts) - 1:
+                raise InputError(where, key, f"an index of the list {'.'.join(parts[:i])} "
+                                             "followed by a key, e.g. 'faults.0.depth'")
+            model, item = item, None
+            continue
         f = model.model_fields.get(p)
         parent = ".".join(parts[:i]) or "the case"
         if f is None or p == "provenance":
@@ -52,6 +59,10 @@ def _case_field(key: str, where: str) -> _CaseField:
         if typing.get_origin(ann) is typing.Annotated:
             ann = typing.get_args(ann)[0]
         is_section = isinstance(ann, type) and issubclass(ann, BaseModel)
+        entry = typing.get_args(ann)[0] if typing.get_origin(ann) is list else None
+        if i < len(parts) - 1 and isinstance(entry, type) and issubclass(entry, BaseModel):
+            item = entry  # a list of tables: the next part is an index
+            continue
         if i < len(parts) - 1:
             if not is_section:
                 raise InputError(where, key, f"a dotted key of the case; "
