@@ -343,8 +343,10 @@ class StiffnessConfig(_Model):
 class SimulationConfig(_Model):
     """Time integration (Newmark) and model choice."""
 
-    model: Literal["I", "II"] = Field("II", description="Model I: K(theta) at the design centre "
-                                                        "distance; model II: K(theta, d(t)).")
+    model: Literal["I", "I-static", "II"] = Field(
+        "II", description="Model I: K(theta) at the design centre distance; I-static: K(theta) at "
+                          "the static operating centre distance (eq. 4), held fixed; model II: "
+                          "K(theta, d(t)).")
     dt: Time = Field(1e-5, gt=0, description="Time step [s].")
     settle_time: Time = Field(0.5, ge=0, description="Simulated time discarded before recording "
                                                      "[s].")

@@ -13,6 +13,7 @@ from ._common import (
     ConfigOption,
     ForceOption,
     SetOption,
+    choice,
     console,
     err_console,
     handle_errors,
@@ -28,7 +29,8 @@ def measure(
     config: ConfigOption = None,
     set_: SetOption = None,
     model: Annotated[str | None, typer.Option(
-        "--model", "-m", help="I or II (default: the case's simulation.model).",
+        "--model", "-m", help="I, I-static or II, any case (default: the case's "
+                              "simulation.model).",
         show_default=False)] = None,
     crack: Annotated[bool, typer.Option("--crack/--no-crack",
                                         help="Include the case's tooth crack in the stiffness.")
@@ -46,16 +48,19 @@ def measure(
     """Simulate the gear pair, pass the bearing forces through the case's measurement chain
     (housing modes, accelerometer, anti-alias filter, sampling, noise, ADC, tachometer) and write
     the record (case.simulation.record_time long) to OUT."""
+    from typing import get_args
+
+    from ..config import SimulationConfig
     from ..errors import InputError
     from ..measurement.record import write_csv, write_mat, write_netcdf
     from ..stiffness import build_map
     from ..studies.measure import chain_from_config
     from ..studies.measure import measure as run_measure
 
+    models = get_args(SimulationConfig.model_fields["model"].annotation)  # "I", "I-static", "II"
+    model = choice("--model", model, models)  # before the case: a bad name fails at once
     case = load_case_from_cli(config, set_)
-    which = case.simulation.model if model is None else model.strip().upper()
-    if which not in ("I", "II"):
-        raise InputError("--model", model, "I or II")
+    which = case.simulation.model if model is None else model
     if stiffness is not None and stiffness not in ("pem", "fe"):
         raise InputError("--stiffness", stiffness, "'pem' or 'fe'")
     if out.exists() and out.is_dir():

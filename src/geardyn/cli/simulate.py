@@ -1,4 +1,4 @@
-"""``geardyn simulate``: model I or model II time response of a case to NetCDF (and .mat)."""
+"""``geardyn simulate``: model I, I-static or II time response of a case to NetCDF (and .mat)."""
 
 from __future__ import annotations
 
@@ -51,9 +51,10 @@ def simulate(
     config: ConfigOption = None,
     set_: SetOption = None,
     model: Annotated[str | None, typer.Option(
-        "--model", "-m", help="I: stiffness at the design centre distance; II: iterated with the "
-                              "operating centre distance; any case (default: the case's "
-                              "simulation.model).", show_default=False)] = None,
+        "--model", "-m", help="I: stiffness at the design centre distance; I-static: at the "
+                              "static operating centre distance (eq. 4), held fixed; II: "
+                              "iterated with the operating centre distance; any case (default: "
+                              "the case's simulation.model).", show_default=False)] = None,
     crack: Annotated[bool, typer.Option("--crack/--no-crack",
                                         help="Include the case's tooth crack in the stiffness.")
                      ] = True,
@@ -69,7 +70,9 @@ def simulate(
 ) -> None:
     """Simulate the gear pair (Newmark, paper section 4) and write the record to OUT."""
     import json
+    from typing import get_args
 
+    from ..config import SimulationConfig
     from ..run_limits import check_step_count
     from ._outputs import (
         OutputInUse,
@@ -80,7 +83,8 @@ def simulate(
         resolve,
     )
 
-    model = choice("--model", model, ("I", "II"))
+    models = get_args(SimulationConfig.model_fields["model"].annotation)  # "I", "I-static", "II"
+    model = choice("--model", model, models)
     stiffness = choice("--stiffness", stiffness, ("pem", "fe"))
     target = resolve(out, DEFAULT_OUT)
     out = target.path
@@ -155,6 +159,10 @@ def simulate(
                   f"{s['mean_contact_ratio']:.4f} (paper eq. 8: {s['mean_contact_ratio_eq8']:.4f})"
                   f", transmission error {s['mean_transmission_error_rad']:.5g} rad "
                   f"(std {s['std_transmission_error_rad']:.3g})")
+    if which == "I-static":
+        console.print(f"  stiffness held at the static centre distance change "
+                      f"{ds.attrs['stiffness_centre_distance_change'] * 1e3:.4f} mm (pressure angle "
+                      f"{math.degrees(ds.attrs['stiffness_pressure_angle']):.4f} deg)")
     if which == "II":
         rb = s["max_residual_before_m"]
         console.print(f"  iterating steps {100 * s['steps_iterating_fraction']:.2f} %, at most "

@@ -65,7 +65,14 @@ __all__ = [
     "check_time_step",
     "operating_arrays",
     "MIN_STEPS_PER_PERIOD",
+    "MODELS",
 ]
+
+#: The models :func:`geardyn.dynamics.simulate` runs. ``"I"``: ``K(theta)`` at the design centre
+#: distance; ``"I-static"``: ``K(theta)`` at the static operating centre distance of eq. 4 (the
+#: bearings deflected by the static mesh force), held fixed during the run; ``"II"``:
+#: ``K(theta, d(t))`` with the centre distance iterated at every step (the paper's Fig. 7).
+MODELS = ("I", "I-static", "II")
 
 #: Fewest time steps per period of the highest natural frequency (and of the mesh) accepted.
 #: Average-acceleration Newmark is unconditionally stable, so this is an accuracy limit: its period
@@ -501,7 +508,7 @@ def static_equilibrium(model: DynamicModel, stiffness_map, *, which: str = "II",
     r"""Static equilibrium at the steady speed, so a simulation starts without start-up impacts.
 
     ``T_cp = T_in(w)``, ``N = (T_cp - q_stp w)/r_b1``, ``y_p = -N/k_yp``, ``y_g = N/k_yg``,
-    ``p = N/k_mb(theta0, dd)`` (``dd`` from eq. 4 for model II, 0 for model I),
+    ``p = N/k_mb(theta0, dd)`` (``dd`` from eq. 4 for models II and I-static, 0 for model I),
     ``theta_m - theta_p = T_cp/k_cp``, ``theta_g - theta_out = T_cg/k_cg`` with
     ``T_cg = N r_b2 - q_stg w_g`` (``docs/verification/dynamics.md``).
 
@@ -509,16 +516,20 @@ def static_equilibrium(model: DynamicModel, stiffness_map, *, which: str = "II",
     ----------
     model : DynamicModel
     stiffness_map : StiffnessMap
-    which : {"I", "II"}
-        Model I evaluates the stiffness at the design centre distance.
+    which : {"I", "I-static", "II"}
+        Model I evaluates the stiffness at the design centre distance (``dd = 0``); model
+        I-static and model II at the static operating centre distance of eq. 4.
     theta0 : float
         Pinion angle at ``t = 0`` [rad].
 
     Raises
     ------
     InputError
-        If the mesh is not loaded (``N <= 0``) or the map does not cover the centre distance.
+        If ``which`` is not one of :data:`MODELS`, the mesh is not loaded (``N <= 0``) or the
+        map does not cover the centre distance.
     """
+    if which not in MODELS:
+        raise InputError("model", which, ", ".join(repr(m) for m in MODELS))
     w = model.speed
     t_in = float(model.input_law.torque(w))
     q = model.damping
@@ -528,7 +539,7 @@ def static_equilibrium(model: DynamicModel, stiffness_map, *, which: str = "II",
     kyp, kyg = model.K0[1, 1], model.K0[3, 3]
     yp, yg = -n / kyp, n / kyg
     dd = _static_dd(model.pair, n, kyp, kyg)
-    dd_eval = dd if which == "II" else 0.0
+    dd_eval = 0.0 if which == "I" else dd
     if not stiffness_map.covers(dd_eval):
         raise InputError("stiffness.centre_distance_max" if dd_eval > stiffness_map.dd[-1]
                          else "stiffness.centre_distance_min",

@@ -1,4 +1,4 @@
-r"""Time integration of model I / model II (Xue & Howard 2018, section 4 and Fig. 7).
+r"""Time integration of model I / I-static / II (Xue & Howard 2018, section 4 and Fig. 7).
 
 :func:`simulate` runs a case: static equilibrium at the steady speed, ``settle_time`` discarded,
 ``record_time`` recorded every ``decimation``-th step, all inside the compiled kernel of
@@ -9,6 +9,11 @@ oscillators with closed-form solutions).
 
 The algorithm, the stiffness evaluation point, the model II iteration and the tooth separation
 rule are described in :mod:`geardyn.dynamics._kernel`.
+
+Model I-static is model I run on the map's ``dd`` axis shifted by the static centre distance
+change ``dd_s`` of eq. 4 (:func:`fixed_distance_arrays`): the kernel's model I evaluates that map
+at ``dd = 0``, i.e. ``K(theta, dd_s)``, and takes ``d + dd_s`` as the centre distance of the
+tooth-error contact geometry. The kernel itself knows only models I and II.
 """
 
 from __future__ import annotations
@@ -23,6 +28,7 @@ from ..errors import GeardynError, InputError, NumericalError
 from ..stiffness.map import MapArrays, StiffnessMap
 from . import _kernel as K
 from .model import (
+    MODELS,
     DynamicModel,
     StaticState,
     TorqueLaw,
@@ -32,7 +38,7 @@ from .model import (
 )
 
 __all__ = ["simulate", "make_setup", "initial_state", "run_steps", "KernelSetup",
-           "CHUNK_STEPS", "CITATIONS"]
+           "fixed_distance_arrays", "CHUNK_STEPS", "CITATIONS"]
 
 #: Steps per kernel call (progress is reported between calls).
 CHUNK_STEPS = 20_000
@@ -311,11 +317,16 @@ def _setup_for_case(case, dyn: DynamicModel, stiffness_map: StiffnessMap, which:
     from ..modifications import ToothModifications
 
     mods = ToothModifications.from_case(case)
+    kernel_map: StiffnessMap | MapArrays = stiffness_map
+    d0 = pair.design_centre_distance
+    if which == "I-static":  # model I on the map seen from the static operating point
+        kernel_map = fixed_distance_arrays(stiffness_map, static.centre_distance_change)
+        d0 = pair.design_centre_distance + static.centre_distance_change
     return make_setup(
-        dyn.M, dyn.K0, C, dyn.g, Q0, stiffness_map, dt=sim.dt, model=which,
+        dyn.M, dyn.K0, C, dyn.g, Q0, kernel_map, dt=sim.dt, model="II" if which == "II" else "I",
         evaluation=sim.stiffness_evaluation, integrator=sim.integrator, hht_alpha=sim.hht_alpha,
         q_mb=dyn.q_mb, rsum=pair.base_radius_sum, t1t2=pair.design_t1t2,
-        d0=pair.design_centre_distance, tolerance=sim.tolerance, rtol=sim.rtol,
+        d0=d0, tolerance=sim.tolerance, rtol=sim.rtol,
         max_iterations=sim.max_iterations, speed=dyn.speed, p_lim=p_lim, y_lim=y_lim,
         separation=True, input_law=dyn.input_law, output_law=dyn.output_law,
         input_speed=dyn.speed, output_speed=dyn.gear_speed,
@@ -323,6 +334,40 @@ def _setup_for_case(case, dyn: DynamicModel, stiffness_map: StiffnessMap, which:
         ripple=(case.motor.ripple * float(dyn.input_law.torque(dyn.speed)),
                 case.motor.ripple_order, case.motor.ripple_phase),
         drive=drive)
+
+
+def fixed_distance_arrays(stiffness_map: StiffnessMap, centre_distance_change: float
+                          ) -> MapArrays:
+    """The map's kernel arrays with the ``dd`` axis moved so that ``dd = 0`` reads
+    ``K(theta, centre_distance_change)``.
+
+    Only ``dd0`` changes (to ``dd[0] - centre_distance_change``); the node values are shared, so
+    model I evaluating this view at ``dd = 0`` interpolates the original map at
+    ``centre_distance_change`` (to rounding of ``dd0``). A one-line map is constant in ``dd`` and
+    unchanged.
+
+    Parameters
+    ----------
+    stiffness_map : StiffnessMap
+    centre_distance_change : float
+        The fixed operating minus design centre distance [m].
+
+    Returns
+    -------
+    MapArrays
+
+    Raises
+    ------
+    InputError
+        If the map does not cover ``centre_distance_change``.
+    """
+    if not stiffness_map.covers(centre_distance_change):
+        raise InputError("stiffness_map", f"range [{stiffness_map.dd[0]:.6g}, "
+                         f"{stiffness_map.dd[-1]:.6g}] m",
+                         f"a map covering the fixed centre distance change "
+                         f"{centre_distance_change:.6g} m")
+    arrays = stiffness_map.arrays()
+    return arrays._replace(dd0=arrays.dd0 - float(centre_distance_change))
 
 
 def _speed_profile(case, dyn: DynamicModel):
@@ -375,7 +420,7 @@ def _start_with_errors(setup: KernelSetup, dyn: DynamicModel, static: StaticStat
 
 def simulate(case, stiffness_map: StiffnessMap | None = None, *, model: str | None = None,
              cracked: bool = True, progress: Callable[[int, int], None] | None = None):
-    r"""Simulate model I or model II of a case and return the record as an xarray Dataset.
+    r"""Simulate model I, I-static or II of a case and return the record as an xarray Dataset.
 
     Parameters
     ----------
@@ -385,9 +430,11 @@ def simulate(case, stiffness_map: StiffnessMap | None = None, *, model: str | No
     stiffness_map : StiffnessMap, optional
         Any map (PEM, FE, a user table). Default:
         ``geardyn.stiffness.build_map(case, cracked=cracked)``.
-    model : {"I", "II"}, optional
+    model : {"I", "I-static", "II"}, optional
         Default ``case.simulation.model``. Model I: ``K(theta)`` at the design centre distance;
-        model II: ``K(theta, d(t))`` iterated each step (the paper's Fig. 7).
+        model I-static: ``K(theta)`` at the static operating centre distance of eq. 4 (the
+        bearings deflected by the static mesh force), held fixed; model II: ``K(theta, d(t))``
+        iterated each step (the paper's Fig. 7).
     cracked : bool
         Passed to ``build_map`` when no map is given.
     progress : callable, optional
@@ -401,7 +448,11 @@ def simulate(case, stiffness_map: StiffnessMap | None = None, *, model: str | No
         ``transmission_error`` (``theta_p - (r_b2/r_b1) theta_g``), ``mesh_force``,
         ``mesh_deflection``, ``centre_distance_change``, ``pressure_angle``, ``contact_ratio``,
         ``contact_ratio_eq8``, ``mesh_stiffness``, ``contact``, ``iterations``,
-        ``residual_before``, ``residual_after``; units and provenance in the attributes.
+        ``residual_before``, ``residual_after``; units and provenance in the attributes
+        (model I-static adds ``stiffness_centre_distance_change`` [m] and the
+        ``stiffness_pressure_angle`` [rad], ``stiffness_contact_ratio`` and
+        ``stiffness_contact_ratio_eq8`` there; its ``centre_distance_change`` is, as in model I,
+        the geometric ``d(t) - d`` of the bearing motion, not the fixed value).
 
     Raises
     ------
@@ -414,8 +465,8 @@ def simulate(case, stiffness_map: StiffnessMap | None = None, *, model: str | No
         (attribute ``complete = 0``).
     """
     which = case.simulation.model if model is None else model
-    if which not in ("I", "II"):
-        raise InputError("model", which, "'I' or 'II'")
+    if which not in MODELS:
+        raise InputError("model", which, ", ".join(repr(m) for m in MODELS))
     check_bounded_work(case)  # before any map, matrix or step: refuse runs that would not end
     if stiffness_map is None:
         from ..stiffness import build_map
@@ -458,6 +509,8 @@ def simulate(case, stiffness_map: StiffnessMap | None = None, *, model: str | No
         if progress is not None:
             progress(done, n_last)
         if status != K.OK:
+            if which == "I-static":  # the kernel's change is from the shifted d0
+                fail[5] += static.centre_distance_change
             ds = _dataset(case, dyn, stiffness_map, which, static, setup, out[:j], n_settle,
                           decim, complete=False)
             exc = _numerical_error(status, fail, stiffness_map, which)
@@ -597,6 +650,10 @@ def _dataset(case, dyn: DynamicModel, stiffness_map: StiffnessMap, which: str,
     data["mesh_force"] = ("time", rows[:, K.R_N], {
         "units": "N", "long_name": "normal mesh force h N (eq. 14)"})
     dd = rows[:, K.R_DD]
+    if which == "I-static":
+        # the kernel's change is from d0 = d + dd_s; adding d0 back is exact (Sterbenz), so the
+        # geometric d(t) - d below rounds exactly as model I's
+        dd = (dd + setup.fp[K.FP_D0]) - dyn.pair.design_centre_distance
     op = operating_arrays(dyn.pair, dd)
     data["centre_distance_change"] = ("time", dd, {
         "units": "m", "long_name": "operating minus design centre distance d(t) - d (eq. 4)"})
@@ -671,6 +728,24 @@ def _dataset(case, dyn: DynamicModel, stiffness_map: StiffnessMap, which: str,
         "steps_without_fixed_point": int(np.sum(rows[:, K.R_RA] >= sim.tolerance)),
         "complete": int(complete),
     }
+    if which == "I-static":
+        dd_s = float(static.centre_distance_change)
+        fixed = operating_arrays(dyn.pair, np.array([dd_s]))
+        attrs.update({
+            "stiffness_centre_distance": "model I-static: K(theta) at the static operating "
+                                         "centre distance of eq. 4 (bearings deflected by the "
+                                         "static mesh force), held fixed; the variables "
+                                         "centre_distance_change, pressure_angle and "
+                                         "contact_ratio* stay the geometric values of the "
+                                         "bearing motion, as in model I",
+            "stiffness_centre_distance_change": dd_s, "stiffness_centre_distance_change_units": "m",
+            "stiffness_pressure_angle": float(fixed["pressure_angle"][0]),
+            "stiffness_pressure_angle_units": "rad",
+            "stiffness_contact_ratio": float(fixed["contact_ratio"][0]),
+            "stiffness_contact_ratio_units": "1",
+            "stiffness_contact_ratio_eq8": float(fixed["contact_ratio_eq8"][0]),
+            "stiffness_contact_ratio_eq8_units": "1",
+        })
     if setup.fp[K.FP_DRIVE_GAIN] != 0.0:
         tp, wp = setup.speed_profile
         attrs["speed_profile"] = (

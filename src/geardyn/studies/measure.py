@@ -108,8 +108,8 @@ def measure(case: Case, stiffness_map=None, *, model: str | None = None, cracked
         ``case.simulation.record_time`` the record length [s].
     stiffness_map : StiffnessMap, optional
         Default ``geardyn.stiffness.build_map(case, cracked=cracked)``.
-    model : {"I", "II"}, optional
-        Default ``case.simulation.model``.
+    model : {"I", "I-static", "II"}, optional
+        Default ``case.simulation.model`` (see :func:`geardyn.dynamics.simulate`).
     cracked : bool
         Passed to ``build_map`` when no map is given.
     progress : callable, optional
