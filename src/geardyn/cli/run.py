@@ -135,6 +135,16 @@ def _print_summary(s: dict, out: Path, lookups: list | None = None) -> None:
     for v in failed:
         err_console.print(f"[yellow]outside tolerance[/yellow]: {escape(v['quantity'])}: "
                           f"geardyn {v['geardyn']:.4g}, paper {v['paper']:.4g}")
+    cmp = s.get("model_comparison", {}).get("cracked", {}).get("signals", {})
+    ratios = {k: [v[k] for v in cmp.values() if v.get(k) is not None]
+              for k in ("rms_ii_minus_i_static", "rms_ii_minus_i", "explained_fraction")}
+    if all(ratios.values()):
+        console.print(
+            "model I-static (K at the static centre distance) vs model II, cracked: within "
+            f"{100 * max(ratios['rms_ii_minus_i_static']):.3g}% of each signal's STD, model I "
+            f"{100 * min(ratios['rms_ii_minus_i']):.3g}-{100 * max(ratios['rms_ii_minus_i']):.3g}"
+            f"%; the static shift explains {100 * min(ratios['explained_fraction']):.3g}-"
+            f"{100 * max(ratios['explained_fraction']):.3g}% of II - I (see the report)")
     meas = s.get("measurement", {})
     if "indicators" in meas:
         h = meas["indicators"]["errors+noise"]["healthy"]

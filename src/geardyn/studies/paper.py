@@ -5,9 +5,12 @@ Stages run in order, each adding to the summary and to the output folder:
 1. ``geometry``: the pair at its design centre distance, at the paper's FE centre distances
    (+0.5, +1.0 mm) and at the static operating point under the input torque (eq. 4).
 2. ``stiffness``: the mesh stiffness maps K(theta, d), healthy and with the crack (Figs. 5, 6).
-3. ``simulation``: model I and model II, cracked and healthy, plus model II with the paper's
-   start-of-step stiffness evaluation for the iteration figure (Figs. 8-10); cached. Each record
-   is written to ``runs/model_<M>_<state>.nc``.
+3. ``simulation``: model I, model I-static (``K(theta)`` at the static operating centre
+   distance of eq. 4, held fixed) and model II, cracked and healthy, plus model II with the
+   paper's start-of-step stiffness evaluation for the iteration figure (Figs. 8-10); cached. Each
+   record is written to ``runs/model_<M>_<state>.nc``. :func:`~.model_compare.compare_models`
+   then splits the model II - model I difference into the static shift and the centre-distance
+   dynamics (``summary["model_comparison"]``).
 4. ``diagnostics``: TSA, spectra, residual, PWVD, demodulation, statistics (Tables 2, 3) and
    condition metrics, healthy against cracked (Figs. 11-23).
 5. ``measurement``: the same indicators on a realistic measurement (housing accelerometer
@@ -217,7 +220,8 @@ def write_run_netcdf(ds, path: Path) -> None:
 
 
 def simulation_stage(case: Case, out: Path, result: StudyResult) -> None:
-    """Model I and II, cracked and healthy; the paper's flow-chart variant for Fig. 9.
+    """Model I, I-static and II, cracked and healthy; the paper's flow-chart variant for Fig. 9;
+    the model comparison (:func:`model_comparison`).
 
     Each record is also written to ``runs/model_<M>_<state>.nc`` (compressed, one file per run).
     """
@@ -226,8 +230,8 @@ def simulation_stage(case: Case, out: Path, result: StudyResult) -> None:
 
     sim_case = _simulation_case(case, result.quick)
     runs = {}
-    jobs = [("I", "cracked"), ("II", "cracked"), ("I", "healthy"), ("II", "healthy"),
-            ("II-start", "cracked")]
+    jobs = [("I", "cracked"), ("I-static", "cracked"), ("II", "cracked"), ("I", "healthy"),
+            ("I-static", "healthy"), ("II", "healthy"), ("II-start", "cracked")]
     rev = 2 * math.pi / (case.load.speed or 114.14)
     scheme_case = sim_case.with_overrides({
         "simulation.stiffness_evaluation": "start",
@@ -280,7 +284,75 @@ def simulation_stage(case: Case, out: Path, result: StudyResult) -> None:
     w9 = (max(ts[0], tc_s - 0.012), min(ts[-1], tc_s + 0.012))
     result.figures["fig9_iteration"] = pf.fig9_iteration(ds_s, ds2, ca, w9,
                                                          case.simulation.tolerance)
-    result.figures["fig10_stiffness"] = pf.fig10_stiffness(runs[("I", "cracked")], ds2, ca, w8)
+    result.figures["fig10_stiffness"] = pf.fig10_stiffness(runs[("I", "cracked")], ds2, ca, w8,
+                                                           ds_i_static=runs[("I-static", "cracked")])
+    result.summary["model_comparison"] = model_comparison(runs)
+    if result.summary["model_comparison"]:
+        result.figures["fig_model_comparison"] = pf.fig_model_comparison(
+            result.summary["model_comparison"])
+
+
+#: Share of the samples whose differences :func:`model_comparison` reports the energy of
+#: (``top_share``): the largest 1 % of ``|II - I-static|``.
+TOP_SAMPLE_FRACTION = 0.01
+
+
+def model_comparison(runs: dict) -> dict:
+    """How much of the model II - model I difference the static centre-distance shift explains.
+
+    :func:`~.model_compare.compare_models` of the model I, I-static and II records of each state,
+    plus, per signal, ``top_share``: the share of the squared difference ``(II - I-static)^2``
+    carried by the largest :data:`TOP_SAMPLE_FRACTION` of its samples (near 1 when the
+    difference sits in isolated steps, such as a tooth handover that falls in a different time
+    step for the two models; about 0.01-0.05 for a difference spread over the record).
+
+    Parameters
+    ----------
+    runs : dict
+        ``(model, state) -> record`` of :func:`geardyn.dynamics.simulate`.
+
+    Returns
+    -------
+    dict
+        ``state -> {"signals": {signal: {"units", "rms_ii_minus_i_static", "rms_ii_minus_i",
+        "explained_fraction", "top_share"}}, "static_centre_distance_change_mm": float,
+        "units": ..., "definitions": ...}`` (dimensionless ratios, ``units = "1"``), for each
+        state whose three records exist.
+    """
+    from .model_compare import compare_models
+
+    out: dict = {}
+    for state in ("cracked", "healthy"):
+        keys = [("I", state), ("I-static", state), ("II", state)]
+        if not all(k in runs for k in keys):
+            continue
+        cmp = compare_models(*(runs[k] for k in keys))
+        signals = {}
+        for i, sig in enumerate(cmp["signal"].values):
+            sig = str(sig)
+            d = (np.asarray(runs[("II", state)][sig].values, dtype=float)
+                 - np.asarray(runs[("I-static", state)][sig].values, dtype=float))
+            e = np.sort(d * d)[::-1]
+            n_top = max(1, int(math.ceil(TOP_SAMPLE_FRACTION * e.size)))
+            tot = float(e.sum())
+            signals[sig] = {
+                "units": str(cmp["signal_units"].values[i]),
+                **{v: float(cmp[v].values[i]) for v in ("rms_ii_minus_i_static",
+                                                         "rms_ii_minus_i",
+                                                         "explained_fraction")},
+                "top_share": float(e[:n_top].sum()) / tot if tot > 0 else float("nan")}
+        out[state] = {
+            "signals": signals,
+            "static_centre_distance_change_mm": 1e3 * float(
+                cmp.attrs["static_centre_distance_change"]),
+            "units": "1 (ratios); signals' units in 'units'",
+            "definitions": {
+                **{v: cmp[v].attrs["long_name"] for v in ("rms_ii_minus_i_static",
+                                                          "rms_ii_minus_i",
+                                                          "explained_fraction")},
+                "top_share": f"share of sum (II - I-static)^2 in the largest "
+                             f"{100 * TOP_SAMPLE_FRACTION:g} % of the samples"}}
+    return out
 
 
 def _diagnose_run(case: Case, ds):
@@ -301,8 +373,9 @@ def paper_tables(cracked: dict) -> tuple[dict, dict]:
     Parameters
     ----------
     cracked : dict
-        ``"I"``, ``"II"`` -> diagnosis (:func:`geardyn.diagnostics.diagnose`) of the cracked
-        record of that model.
+        ``"I"``, ``"II"`` and optionally ``"I-static"`` -> diagnosis
+        (:func:`geardyn.diagnostics.diagnose`) of the cracked record of that model (the paper
+        has no I-static: its values are geardyn's only).
 
     Returns
     -------
@@ -313,7 +386,7 @@ def paper_tables(cracked: dict) -> tuple[dict, dict]:
     t3: dict = {}
     for sig, name in SIGNAL_KEYS.items():
         t2[name], t3[name] = {}, {}
-        for m in ("I", "II"):
+        for m in [m for m in ("I", "I-static", "II") if m in cracked]:
             sd = cracked[m].signals[sig]
             st = sd.statistics
             t2[name][m] = {"mean": st.mean, "std": st.std, "skewness": st.skewness,
@@ -371,7 +444,7 @@ def diagnostics_stage(case: Case, out: Path, result: StudyResult) -> None:
 
     z = case.pinion.teeth
     diags = {}
-    keys = [k for k in result.sims if k[0] in ("I", "II")]
+    keys = [k for k in result.sims if k[0] in ("I", "II") or k == ("I-static", "cracked")]
     for i, key in enumerate(keys):
         result.emit(f"diagnostics: model {key[0]}, {key[1]}", i, len(keys))
         diags[key] = _diagnose_run(case, result.sims[key])
@@ -379,7 +452,8 @@ def diagnostics_stage(case: Case, out: Path, result: StudyResult) -> None:
     result.diagnoses = diags
     cracked = {m: diags[(m, "cracked")] for m in ("I", "II")}
 
-    t2, t3 = paper_tables(cracked)
+    t2, t3 = paper_tables({**cracked, **({"I-static": diags[("I-static", "cracked")]}
+                                         if ("I-static", "cracked") in diags else {})})
     result.summary["table2"] = t2
     result.summary["table3"] = t3
 

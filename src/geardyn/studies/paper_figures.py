@@ -13,7 +13,7 @@ from matplotlib.figure import Figure
 
 __all__ = ["SIGNALS", "fig8_design_parameters", "fig9_iteration", "fig10_stiffness",
            "fig_tsa", "fig_spectra", "fig_residuals", "fig_pwvd_pair", "fig_demodulation_pair",
-           "fig_analytic_pair", "crack_times", "fig_measured_tsa"]
+           "fig_analytic_pair", "crack_times", "fig_measured_tsa", "fig_model_comparison"]
 
 #: The paper's three signals: name -> (label, unit, symbol)
 SIGNALS = {
@@ -22,7 +22,7 @@ SIGNALS = {
     "transmission_error": ("transmission error", "rad", r"$\theta_p - \theta_g$"),
 }
 MODELS = ("I", "II")
-COLORS = {"I": "#1f77b4", "II": "#d62728"}
+COLORS = {"I": "#1f77b4", "II": "#d62728", "I-static": "#2ca02c"}
 
 
 def crack_times(ds, crack_angle: float) -> np.ndarray:
@@ -113,15 +113,23 @@ def fig9_iteration(ds_scheme, ds_default, crack_angle: float | None,
     return fig
 
 
-def fig10_stiffness(ds_i, ds_ii, crack_angle: float | None, window: tuple[float, float]) -> Figure:
-    """Fig. 10 analogue: the mesh stiffness the two models used, K_m(theta) and K_m(theta, d)."""
+def fig10_stiffness(ds_i, ds_ii, crack_angle: float | None, window: tuple[float, float],
+                    ds_i_static=None) -> Figure:
+    """Fig. 10 analogue: the mesh stiffness the models used, K_m(theta) and K_m(theta, d).
+
+    With ``ds_i_static`` (a model I-static record) its K_m(theta, d_s) at the static operating
+    centre distance is drawn dashed over model II's (the paper has no such curve)."""
     fig = Figure(figsize=(8.5, 3.8), layout="constrained")
     ax = fig.subplots()
-    for ds, lab, m in ((ds_i, r"model I, $K_m(\theta)$", "I"),
-                       (ds_ii, r"model II, $K_m(\theta, d)$", "II")):
+    curves = [(ds_i, r"model I, $K_m(\theta)$", "I", "-", 0.9),
+              (ds_ii, r"model II, $K_m(\theta, d)$", "II", "-", 0.9)]
+    if ds_i_static is not None:
+        curves.append((ds_i_static, r"model I-static, $K_m(\theta, d_s)$ (dashed)", "I-static",
+                       "--", 1.1))
+    for ds, lab, m, ls, lw in curves:
         sel = _window(ds, *window)
-        ax.plot(ds["time"].values[sel], ds["mesh_stiffness"].values[sel], lw=0.9, label=lab,
-                color=COLORS[m])
+        ax.plot(ds["time"].values[sel], ds["mesh_stiffness"].values[sel], lw=lw, ls=ls,
+                label=lab, color=COLORS[m])
     if crack_angle is not None:
         for tc in crack_times(ds_ii, crack_angle):
             if window[0] <= tc <= window[1]:
@@ -318,4 +326,37 @@ def fig_measured_tsa(tsas: dict, model: str) -> Figure:
     axs[0].legend(fontsize=8, loc="upper right")
     _deg_axis(axs[1])
     axs[1].set_xlabel("shaft angle from the tachometer pulse [deg]")
+    return fig
+
+
+def fig_model_comparison(comparison: dict) -> Figure:
+    """RMS(II - I) / STD(II) and RMS(II - I-static) / STD(II) per signal, one panel per state.
+
+    Parameters
+    ----------
+    comparison : dict
+        ``state -> {"signals": {signal: {"rms_ii_minus_i", "rms_ii_minus_i_static", ...}}}``
+        (``summary["model_comparison"]`` of the study).
+    """
+    states = [st for st in ("cracked", "healthy") if st in comparison]
+    fig = Figure(figsize=(10.0, 3.4 * max(1, len(states))), layout="constrained")
+    axs = np.atleast_1d(fig.subplots(max(1, len(states)), 1, squeeze=False)[:, 0])
+    for ax, st in zip(axs, states, strict=False):
+        sig = comparison[st]["signals"]
+        names = list(sig)
+        x = np.arange(len(names))
+        for off, key, lab, m in ((-0.2, "rms_ii_minus_i", "RMS(II - I) / STD(II)", "I"),
+                                 (0.2, "rms_ii_minus_i_static", "RMS(II - I-static) / STD(II)",
+                                  "I-static")):
+            v = np.array([sig[n][key] if sig[n][key] is not None else np.nan for n in names],
+                         dtype=float)
+            ax.bar(x + off, 100.0 * v, width=0.4, label=lab, color=COLORS[m])
+        ax.set_yscale("log")
+        ax.set_xticks(x)
+        ax.set_xticklabels([n.replace("_", " ") for n in names], rotation=20, fontsize=8)
+        ax.set_ylabel("% of STD(II)")
+        ax.set_title(f"{st} pair: distance of model I and model I-static from model II",
+                     fontsize=9)
+        ax.grid(alpha=0.3, which="both", axis="y")
+        ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.0, 1.0))
     return fig

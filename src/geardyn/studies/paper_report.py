@@ -29,7 +29,8 @@ from .paper_values import (
 )
 from .report import Report
 
-__all__ = ["report_stage", "write_results_netcdf", "ERRATA", "CITATIONS", "disagreements"]
+__all__ = ["report_stage", "write_results_netcdf", "ERRATA", "CITATIONS", "disagreements",
+           "model_comparison_statements", "TABLE_MODELS"]
 
 ERRATA = [
     "Table 1's 'base radius 129.7 mm' of each gear is the sum r_b1 + r_b2; each base radius is "
@@ -91,6 +92,15 @@ CITATIONS = [
     "Lebold, M., McClintic, K., Campbell, R., Byington, C. & Maynard, K. (2000). Review of "
     "vibration analysis methods for gearbox diagnostics and prognostics. Proc. 54th MFPT.",
 ]
+
+#: Models of Tables 2 and 3 in the report and results.nc, in column order (model I-static is
+#: geardyn's: the paper has no such column).
+TABLE_MODELS = ("I", "I-static", "II")
+
+#: The model comparison's ratios (``summary["model_comparison"]``), as results.nc variables.
+MODEL_COMPARISON_VARIABLES = ("rms_ii_minus_i_static", "rms_ii_minus_i", "explained_fraction",
+                              "top_share")
+
 
 def _versions() -> list[tuple[str, str]]:
     return package_versions()
@@ -210,8 +220,10 @@ def disagreements(s: dict) -> list[str]:
 
 #: How results.nc is laid out (its root attribute ``contents`` and the report say the same).
 RESULTS_LAYOUT = (
-    "results.nc: the root group holds Tables 2 and 3, the condition metrics and the indicators "
-    "on the realistic measurement (measured_indicators) as variables "
+    "results.nc: the root group holds Tables 2 and 3 (models I, I-static and II), the condition "
+    "metrics, the model comparison (rms_ii_minus_i_static, rms_ii_minus_i, explained_fraction "
+    "per state and signal) and the indicators on the realistic measurement "
+    "(measured_indicators) as variables "
     "(xarray.open_dataset('results.nc') shows them) and the summary (JSON) and case (TOML) as "
     "attributes; groups stiffness/healthy, stiffness/cracked (the maps) and "
     "diagnostics/model_<M>_<state> (TSA, residual, envelope, AM, PM, RMS spectrum on the angle "
@@ -230,7 +242,7 @@ def _tables_dataset(result: StudyResult, case: Case):
 
     s = result.summary
     sigs = list(SIGNAL_KEYS.values())
-    models = ["I", "II"]
+    models = list(TABLE_MODELS)
     data = {}
     units = {"gear_vertical_velocity": "m/s", "pinion_angular_velocity": "rad/s",
              "transmission_error": "rad"}
@@ -246,27 +258,33 @@ def _tables_dataset(result: StudyResult, case: Case):
         data["table2"] = (("signal", "model", "statistic2"), arr(t2, st2), {
             "long_name": "statistics of the TSA of the cracked records (paper's Table 2): mean "
                          "and STD in the signal's unit (see signal_units), skewness g1, Pearson "
-                         "kurtosis, crest factor max|x - mean|/STD", "units": "see signal_units"})
+                         "kurtosis, crest factor max|x - mean|/STD; model I-static is "
+                         "geardyn's addition (K(theta) at the static operating centre distance)",
+            "units": "see signal_units"})
         data["table3"] = (("signal", "model", "statistic3"), arr(t3, st3), {
             "long_name": "kurtoses of the narrowband envelope, AM, PM and residual of the "
                          "cracked records (paper's Table 3); pm_mean_deg in deg",
             "units": "1"})
         if result.paper_case:
             data["paper_table2"] = (("signal", "model", "statistic2"), arr(PAPER_TABLE2, st2),
-                                    {"long_name": "the paper's Table 2", "units": "see signal_units"})
+                                    {"long_name": "the paper's Table 2 (NaN for model I-static: "
+                                                  "not in the paper)",
+                                     "units": "see signal_units"})
             data["paper_table3"] = (("signal", "model", "statistic3"),
                                     arr(PAPER_TABLE3, st3[:4] + ["-"]),
-                                    {"long_name": "the paper's Table 3 and residual kurtoses",
+                                    {"long_name": "the paper's Table 3 and residual kurtoses "
+                                                  "(NaN for model I-static: not in the paper)",
                                      "units": "1"})
     cm = s.get("condition_metrics", {})
     if cm:
-        vals = np.array([[[[np.nan if cm[g][m][state][k] is None else cm[g][m][state][k]
+        vals = np.array([[[[np.nan if m not in cm[g] or cm[g][m][state][k] is None
+                             else cm[g][m][state][k]
                             for k in CONDITION_METRICS] for state in ("healthy", "cracked")]
                           for m in models] for g in sigs], dtype=float)
         undefined = s.get("condition_metrics_undefined", {})
         data["condition_metrics"] = (("signal", "model", "state", "metric"), vals, {
             "long_name": "condition metrics of the TSA (MATLAB gearConditionMetrics names); NaN "
-                         "where undefined", "units": "1",
+                         "where undefined and for model I-static (not computed)", "units": "1",
             "undefined": json.dumps(undefined)})
     meas = s.get("measurement", {})
     if "indicators" in meas:
@@ -282,13 +300,36 @@ def _tables_dataset(result: StudyResult, case: Case):
                          "ideal, tooth errors only, noise only, errors + noise",
             "units": "1", "tooth_errors": meas.get("errors", ""),
             "noise": meas.get("noise", ""), "transfer_path": meas.get("chain", "")})
+    mc = s.get("model_comparison", {})
+    mc_states = [st for st in ("cracked", "healthy") if st in mc]
+    mc_signals = list(mc[mc_states[0]]["signals"]) if mc_states else []
+    if mc_states:
+        for var in MODEL_COMPARISON_VARIABLES:
+            vals = np.array([[np.nan if mc[st]["signals"][g].get(var) is None
+                              else mc[st]["signals"][g][var] for g in mc_signals]
+                             for st in mc_states], dtype=float)
+            data[var] = (("comparison_state", "compared_signal"), vals, {
+                "units": "1", "long_name": mc[mc_states[0]]["definitions"][var],
+                "records": "runs/model_I_<state>.nc, runs/model_I-static_<state>.nc, "
+                           "runs/model_II_<state>.nc"})
+        data["static_centre_distance_change"] = ("comparison_state", np.array(
+            [mc[st]["static_centre_distance_change_mm"] * 1e-3 for st in mc_states]), {
+                "units": "m", "long_name": "centre distance change at which model I-static "
+                                           "reads K(theta) (static operating point, eq. 4)"})
     coords = {"signal": sigs, "model": models, "statistic2": st2, "statistic3": st3,
               "state": ["healthy", "cracked"], "metric": list(CONDITION_METRICS)}
+    if mc_states:
+        coords["comparison_state"] = mc_states
+        coords["compared_signal"] = mc_signals
+        coords["compared_signal_units"] = ("compared_signal",
+                                           [mc[mc_states[0]]["signals"][g]["units"]
+                                            for g in mc_signals])
     if "indicators" in meas:
         coords["variant"] = list(VARIANTS)
         coords["indicator"] = [k for k, _, _ in INDICATORS]
     ds = xr.Dataset(data, coords={k: v for k, v in coords.items()
-                                  if any(k in d[0] for d in data.values())})
+                                  if any(k in d[0] for d in data.values())
+                                  or (k == "compared_signal_units" and mc_states)})
     ds.attrs.update({
         "title": (f"geardyn: {'the Xue & Howard (2018) case study' if result.paper_case else ''}"
                   f"{'' if result.paper_case else repr(case.name) + ' (not the paper case)'}"),
@@ -527,7 +568,7 @@ def report_stage(case: Case, out: Path, result: StudyResult) -> None:
     fig("fig6_crack", "Fig. 6 analogue: healthy (K00) and cracked (KC005, KC105) stiffness.")
 
     # ---------------------------------------------------------------- dynamics
-    rep.heading("Dynamics, model I and model II (Figs. 8-10)")
+    rep.heading("Dynamics, model I, model I-static and model II (Figs. 8-10)")
     sims = s.get("simulations", {})
     srows = []
     for key, v in sims.items():
@@ -546,7 +587,11 @@ def report_stage(case: Case, out: Path, result: StudyResult) -> None:
     fig("fig9_iteration", "Fig. 9 analogue: |b1 - b2| before and after the iteration, the "
                           "number of iterations and the mesh stiffness used.")
     fig("fig10_stiffness", "Fig. 10 analogue: mesh stiffness used by model I, K_m(theta), and "
-                           "by model II, K_m(theta, d).")
+                           "by model II, K_m(theta, d); dashed: model I-static, K_m(theta, d_s) "
+                           "at the static operating centre distance (not in the paper).")
+    mc = s.get("model_comparison", {})
+    if mc:
+        _model_comparison_section(rep, mc, method, fig)
 
     # ---------------------------------------------------------------- diagnostics
     rep.heading("Diagnostics (Figs. 11-23, Tables 2 and 3)")
@@ -559,21 +604,17 @@ def report_stage(case: Case, out: Path, result: StudyResult) -> None:
             continue
         for metric in ("mean", "std", "skewness", "kurtosis", "crest_factor"):
             first = title if metric == "mean" else ""
-            if paper:
-                rows2.append([first, metric.replace("_", " "), PAPER_TABLE2[name]["I"][metric],
-                              t2[name]["I"][metric], PAPER_TABLE2[name]["II"][metric],
-                              t2[name]["II"][metric]])
-            else:
-                rows2.append([first, metric.replace("_", " "), t2[name]["I"][metric],
-                              t2[name]["II"][metric]])
+            rows2.append([first, metric.replace("_", " "),
+                          *_model_cells(t2[name], PAPER_TABLE2[name] if paper else None, metric)])
     cap2 = ("Table 2: statistics of the TSA (STD ddof 0, skewness g1, Pearson kurtosis, crest "
             "factor max|x - mean|/STD)")
     if paper:
-        rep.table(["signal", "statistic", "paper, model I", "geardyn, model I",
-                   "paper, model II", "geardyn, model II"], rows2, left_columns=2, caption=cap2)
+        rep.table(["signal", "statistic", *_model_headers(True)], rows2, left_columns=2,
+                  caption=cap2 + I_STATIC_COLUMN_NOTE)
     else:
-        rep.table(["signal", "statistic", "model I", "model II"], rows2, left_columns=2,
-                  caption=cap2.replace("Table 2", "Statistics as the paper's Table 2"))
+        rep.table(["signal", "statistic", *_model_headers(False)], rows2, left_columns=2,
+                  caption=cap2.replace("Table 2", "Statistics as the paper's Table 2")
+                  + I_STATIC_COLUMN_NOTE)
     fig("fig12_spectra", "Fig. 12 analogue: RMS order spectra of the TSAs in dB re 1 unit, "
                          "mean removed (no DC bin); dotted lines mark the mesh harmonics.")
     fig("fig13_residuals", "Fig. 13 analogue: residual signals (all mesh harmonics removed).")
@@ -600,19 +641,16 @@ def report_stage(case: Case, out: Path, result: StudyResult) -> None:
                               ("pm_kurtosis", "phase modulation kurtosis"),
                               ("residual_kurtosis", "residual kurtosis (text of Fig. 13)")):
             first = title if metric == "envelope_kurtosis" else ""
-            if paper:
-                rows3.append([first, label, PAPER_TABLE3[name]["I"][metric],
-                              t3[name]["I"][metric], PAPER_TABLE3[name]["II"][metric],
-                              t3[name]["II"][metric]])
-            else:
-                rows3.append([first, label, t3[name]["I"][metric], t3[name]["II"][metric]])
+            rows3.append([first, label,
+                          *_model_cells(t3[name], PAPER_TABLE3[name] if paper else None, metric)])
     cap3 = "Table 3: kurtoses of the demodulated signals and of the residual"
     if paper:
-        rep.table(["signal", "quantity", "paper, model I", "geardyn, model I", "paper, model II",
-                   "geardyn, model II"], rows3, left_columns=2, caption=cap3)
+        rep.table(["signal", "quantity", *_model_headers(True)], rows3, left_columns=2,
+                  caption=cap3 + I_STATIC_COLUMN_NOTE)
     else:
-        rep.table(["signal", "quantity", "model I", "model II"], rows3, left_columns=2,
-                  caption=cap3.replace("Table 3", "As the paper's Table 3"))
+        rep.table(["signal", "quantity", *_model_headers(False)], rows3, left_columns=2,
+                  caption=cap3.replace("Table 3", "As the paper's Table 3")
+                  + I_STATIC_COLUMN_NOTE)
 
     cm = s.get("condition_metrics", {})
     if cm:
@@ -801,3 +839,129 @@ def _measurement_section(rep: Report, m: dict, result: StudyResult, fig) -> None
                   "modifications.gear.grade=6 --set modifications.gear.seed=2 --no-crack "
                   "--out healthy.nc, then geardyn diagnose healthy.nc --signal acc --tach tach "
                   "--teeth 23 (for this case's own errors, leave out the --set options).")
+
+
+#: Appended to the captions of Tables 2 and 3.
+I_STATIC_COLUMN_NOTE = (". Model I-static (K(theta) at the static operating centre distance, "
+                        "held fixed) is geardyn's addition: the paper has no such model ('-')")
+
+
+def _model_headers(paper: bool) -> list[str]:
+    """Column headers of Tables 2 and 3 after the signal and statistic columns."""
+    if paper:
+        return [h for m in TABLE_MODELS for h in (f"paper, model {m}", f"geardyn, model {m}")]
+    return [f"model {m}" for m in TABLE_MODELS]
+
+
+def _model_cells(ours: dict, theirs: dict | None, key: str) -> list:
+    """One row's cells of Table 2 or 3 (``theirs``: the paper's values, None off the paper's
+    case); '-' where a model has no value (the paper's I-static, an older summary)."""
+    cells = []
+    for m in TABLE_MODELS:
+        if theirs is not None:
+            cells.append(theirs.get(m, {}).get(key, "-"))
+        cells.append(ours.get(m, {}).get(key, "-"))
+    return cells
+
+
+def _pct(x) -> str:
+    return "-" if x is None or not math.isfinite(x) else f"{100.0 * x:.3g} %"
+
+
+def _finite(signals: dict, key: str) -> dict:
+    """``signal -> value`` of ``key`` where it is a finite number."""
+    return {n: v[key] for n, v in signals.items()
+            if v.get(key) is not None and math.isfinite(v[key])}
+
+
+def model_comparison_statements(mc: dict, method: str) -> list[str]:
+    """What the model comparison says, in words, generated from its numbers.
+
+    Parameters
+    ----------
+    mc : dict
+        ``summary["model_comparison"]`` (:func:`geardyn.studies.paper.model_comparison`).
+    method : {"fe", "pem"}
+        Stiffness method of the run (the PEM's handover steps get their own sentence).
+
+    Returns
+    -------
+    list of str
+        One statement per state, then one on where the remaining difference sits, and for the
+        PEM one on what that means.
+    """
+    out = []
+    tops = []
+    for st in ("cracked", "healthy"):
+        if st not in mc:
+            continue
+        sig = mc[st]["signals"]
+
+        d_s, d_1, f, top = (_finite(sig, k) for k in ("rms_ii_minus_i_static",
+                                                      "rms_ii_minus_i", "explained_fraction",
+                                                      "top_share"))
+        tops += list(top.values())
+        if not d_s or not d_1:
+            continue
+        worst = max(d_s, key=d_s.get)
+        text = (f"{st.capitalize()} pair: model I-static reproduces model II to within "
+                f"{_pct(d_s[worst])} of each signal's STD (largest over the {len(d_s)} signals: "
+                f"{worst.replace('_', ' ')}), against {_pct(min(d_1.values()))} to "
+                f"{_pct(max(d_1.values()))} for model I")
+        if f:
+            text += (f"; the static shift of the operating point (centre distance change "
+                     f"{mc[st]['static_centre_distance_change_mm']:.4g} mm) explains "
+                     f"{_pct(min(f.values()))} to {_pct(max(f.values()))} of the model II - "
+                     "model I difference (RMS)")
+        text += (f". On this case what model II adds beyond the static shift (the "
+                 f"centre-distance dynamics, and time-step effects) is at most {_pct(d_s[worst])} "
+                 "of a signal's STD.")
+        out.append(text)
+    if tops:
+        out.append(f"Where the remaining difference sits: the largest 1 % of the samples carry "
+                   f"{_pct(min(tops))} to {_pct(max(tops))} of the squared model II - model "
+                   "I-static difference (over the signals and states; about 1 % for a "
+                   "difference spread evenly over the record, near 100 % for isolated steps).")
+    if method == "pem" and out:
+        out.append(
+            "With the potential-energy map the single/double contact handovers move with the "
+            "centre distance, so model II's few-micrometre motion about the static point puts "
+            "some handovers in a different time step than model I-static's: the records then "
+            "differ by isolated one-step events. geardyn's verification of model I-static (paper "
+            "case, PEM map, time steps 10, 5 and 2.5 us) finds the velocity and "
+            "transmission-error part of that gap shrinking with the time step and the mesh "
+            "force's one-step spikes not: part of the model II - model I-static difference above is "
+            "a time-step effect of the PEM's sharp handovers, not centre-distance dynamics.")
+    return out
+
+
+def _model_comparison_section(rep: Report, mc: dict, method: str, fig) -> None:
+    """The model comparison: table, figure and the generated statements."""
+    rep.heading("How much of the model II - model I difference the static shift explains",
+                level=3)
+    rep.paragraph(
+        "Model I reads the mesh stiffness at the design centre distance, model II at the "
+        "operating centre distance iterated every step, and model I-static (geardyn's addition, "
+        "not in the paper) at the static operating centre distance of eq. 4, held fixed. Model "
+        "II differs from model I-static only through the centre-distance dynamics, from model I "
+        "through those and the static shift. Per signal, over the recorded time: RMS of the "
+        "difference (its mean included) over model II's standard deviation; explained fraction "
+        "1 - RMS(II - I-static) / RMS(II - I) (1: the static shift explains all of the model "
+        "II - model I difference); top 1 %: the share of the squared II - I-static difference "
+        "in the largest 1 % of its samples.")
+    rows = []
+    for st in ("cracked", "healthy"):
+        if st not in mc:
+            continue
+        for i, (name, v) in enumerate(mc[st]["signals"].items()):
+            rows.append([st if i == 0 else "", name.replace("_", " "), v.get("units", ""),
+                         _pct(v.get("rms_ii_minus_i_static")), _pct(v.get("rms_ii_minus_i")),
+                         _pct(v.get("explained_fraction")), _pct(v.get("top_share"))])
+    rep.table(["pair", "signal", "unit", "RMS(II - I-static) / STD(II)", "RMS(II - I) / STD(II)",
+               "explained fraction", "top 1 % share"], rows, left_columns=3,
+              caption="Model I and model I-static against model II (compare_models of the "
+                      "records in runs/)")
+    fig("fig_model_comparison", "RMS(II - I) / STD(II) and RMS(II - I-static) / STD(II) per "
+                                "signal (log scale).")
+    rep.paragraph("What the numbers say (generated from the table):")
+    rep.bullets(model_comparison_statements(mc, method))

@@ -14,8 +14,9 @@ Progress protocol
   with its own count that runs from 0 to ``total`` and is never reused for another count; the
   text after ``": "`` names the item in progress. Bars: ``"stiffness (healthy)"`` and
   ``"stiffness (cracked)"`` (the map builder's own count: FE solves or PEM grid lines; one step
-  when the map comes from the cache), ``"simulation"`` (5 records: model I and II, cracked and
-  healthy, and model II with the paper's start-of-step scheme), ``"diagnostics"`` (4 records),
+  when the map comes from the cache), ``"simulation"`` (7 records: model I, I-static and II,
+  cracked and healthy, and model II with the paper's start-of-step scheme), ``"diagnostics"``
+  (5 records: model I and II, cracked and healthy, and model I-static cracked),
   ``"measurement"`` (10 steps: two simulations with tooth errors, then 8 measured records; 0
   then 10 when the results come from the cache) and ``"report"`` (figures, then the files). A
   count call always carries an item when its ``total`` equals the number of stages, so it
