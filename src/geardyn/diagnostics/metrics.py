@@ -315,7 +315,8 @@ def na4_star(r, baseline_variance: float) -> float:
     if not s > 0:
         return 0.0
     v = float(baseline_variance) / s / s  # v0 in the scaled unit
-    return float(np.mean(z**4)) / v**2 if v > 0 else math.inf
+    # divided by v twice: v**2 underflows to 0 for v < ~1e-162, the quotient overflows to inf
+    return float(np.mean(z**4)) / v / v if v > 0 else math.inf
 
 
 class NA4Tracker:
