@@ -32,12 +32,14 @@ def test_geometry_json_at_operating_point():
     assert s["operating"]["contact_ratio"]["physical"] == pytest.approx(1.4198, abs=1e-4)
 
 
+@pytest.mark.slow
 def test_geometry_table():
     r = run("geometry")
     assert r.returncode == 0
     assert "1.5916" in r.stdout and "138.0000" in r.stdout and "[mm]" in r.stdout
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("args", "words"), [
     (["geometry", "--set", "pinion.teeth=-3"], "pinion.teeth"),
     (["geometry", "--set", "pinion.teeth=22.5"], "pinion.teeth"),
@@ -55,6 +57,7 @@ def test_bad_input_exits_2_with_one_clear_line(args, words):
     assert "Traceback" not in r.stderr + r.stdout
 
 
+@pytest.mark.slow
 def test_config_show_round_trips(tmp_path):
     r = run("config", "show", "--set", "pinion.teeth=25")
     assert r.returncode == 0

@@ -32,7 +32,9 @@ def test_version(flag):
     assert r.stdout.strip() == f"geardyn {geardyn.__version__}"
 
 
-@pytest.mark.parametrize("command", [[]] + COMMANDS, ids=lambda c: " ".join(c) or "geardyn")
+# the top-level help in the fast tier, every subcommand's (20 subprocesses) in the slow tier
+@pytest.mark.parametrize("command", [[]] + [pytest.param(c, marks=pytest.mark.slow) for c in COMMANDS],
+                         ids=lambda c: " ".join(c) or "geardyn")
 def test_short_help_on_every_command_without_bool_metavars_or_stray_spaces(command):
     short, long_ = run(*command, "-h"), run(*command, "--help")
     assert short.returncode == 0 and long_.returncode == 0, short.stderr
@@ -49,6 +51,7 @@ def test_units_in_square_brackets_survive_in_help():
     assert "pulse times [s]" in " ".join(r.stdout.replace("│", " ").split())
 
 
+@pytest.mark.slow
 def test_choices_are_case_insensitive(tmp_path):
     env = {"GEARDYN_CACHE_DIR": str(tmp_path / "c")}
     short = ["--set", "simulation.settle_time=0.002", "--set", "simulation.record_time=0.004",
@@ -62,6 +65,7 @@ def test_choices_are_case_insensitive(tmp_path):
     assert not (tmp_path / "unused").exists()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("case_method", "option", "expected"), [
     ("fe", [], "fe map, healthy"),
     ("pem", [], "pem map, healthy"),
@@ -86,6 +90,7 @@ def test_stiffness_uses_the_case_method_unless_told(tmp_path, case_method, optio
     assert ready.read_text().splitlines()[0] == expected
 
 
+@pytest.mark.slow
 def test_python_warnings_are_one_clean_line(tmp_path):
     """A diagnostics warning (too few revolutions to average) is printed as "warning (...): ..."
     on one line, without the source path and code line Python's default shows."""

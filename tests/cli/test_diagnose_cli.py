@@ -37,6 +37,7 @@ def test_diagnose_measured_csv(tmp_path):
     assert len(list((out / "figures").glob("acc_*.png"))) == 7
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("args", "words"), [
     (["--time", "t", "--signal", "acc"], "angle"),
     (["--time", "t", "--angle", "nope", "--signal", "acc"], "nope"),

@@ -6,6 +6,7 @@ import os
 import subprocess
 import sys
 
+import pytest
 import xarray as xr
 
 GEARDYN = [sys.executable, "-m", "geardyn"]
@@ -20,6 +21,7 @@ def run(*args, cache):
                           timeout=300)
 
 
+@pytest.mark.slow
 def test_simulate_writes_netcdf_and_mat(tmp_path):
     out = tmp_path / "sim.nc"
     r = run("simulate", "--model", "II", "--out", str(out), "--mat", *SHORT, cache=tmp_path / "c")
@@ -33,6 +35,7 @@ def test_simulate_writes_netcdf_and_mat(tmp_path):
         assert ds.attrs["stiffness_cracked"] == 1
 
 
+@pytest.mark.slow
 def test_simulate_model_i_without_crack(tmp_path):
     out = tmp_path / "a.nc"
     r = run("simulate", "-m", "i", "--no-crack", "-o", str(out), *SHORT, cache=tmp_path / "c")
@@ -41,6 +44,7 @@ def test_simulate_model_i_without_crack(tmp_path):
         assert ds.attrs["model"] == "I" and ds.attrs["stiffness_cracked"] == 0
 
 
+@pytest.mark.slow
 def test_simulate_refuses_bad_input(tmp_path):
     r = run("simulate", "--set", "simulation.dt=1e-4", "-o", str(tmp_path / "x.nc"), *SHORT,
             cache=tmp_path / "c")
@@ -51,6 +55,7 @@ def test_simulate_refuses_bad_input(tmp_path):
     assert r.returncode == 2 and "--model" in r.stderr
 
 
+@pytest.mark.slow
 def test_simulate_failure_writes_the_partial_record(tmp_path):
     out = tmp_path / "p.nc"
     r = run("simulate", "-m", "II", "-o", str(out), *SHORT,

@@ -57,6 +57,7 @@ def _invoke(args, cache):
     return CliRunner().invoke(app, args, env={"GEARDYN_CACHE_DIR": str(cache)})
 
 
+@pytest.mark.slow
 def test_stiffness_without_a_crack(tmp_path):
     out = tmp_path / "out"
     r = _invoke(["stiffness", "--out", str(out), "--set", "crack.enabled=false", *SMALL],

@@ -45,6 +45,7 @@ def _args(command, out, tmp_path):
     return [command, "--out", str(out), *PEM]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("command", ["run", "stiffness", "simulate", "diagnose"])
 def test_out_that_is_an_existing_file_is_refused_first(tmp_path, command):
     out = tmp_path / "a-file"
@@ -61,6 +62,7 @@ def test_simulate_out_that_is_a_folder_is_refused_first(tmp_path):
     assert not (tmp_path / "cache").exists()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("command", ["run", "stiffness", "simulate", "diagnose"])
 def test_unwritable_out_is_refused_first(tmp_path, command):
     # /proc refuses new files even to root; a chmod-ed folder would not stop root
@@ -77,6 +79,7 @@ def test_out_below_a_file_is_refused_first(tmp_path):
     assert "is a file, not a folder" in line
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("override", [
     ["--set", "simulation.settle_time=1e6 s"],
     ["--set", "simulation.dt=1e-12 s", "--set", "simulation.decimation=1000000"],

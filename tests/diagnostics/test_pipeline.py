@@ -104,6 +104,7 @@ def test_to_dict_is_json_and_complete(sim_result):
     assert d["settings"]["residual_preset"] == "paper"
 
 
+@pytest.mark.slow
 def test_write_is_atomic_and_complete(tmp_path, sim_file):
     res = diagnose_file(sim_file, signals=["v_yg"], samples_per_rev=512)
     out = res.write(tmp_path / "report")

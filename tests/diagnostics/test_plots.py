@@ -46,6 +46,7 @@ def products():
     return t_res, dem
 
 
+@pytest.mark.slow
 def test_every_figure_has_units_and_renders(products):
     from matplotlib.figure import Figure
 

@@ -127,6 +127,7 @@ def test_inter_tooth_coupling_is_physical(steel_model):
         assert np.all(h > torsion) and np.all(h < 2.0 * torsion)
 
 
+@pytest.mark.slow
 def test_paper_trends_centre_distance(paper_models):
     """Fig. 5: stiffness falls and the single-contact zone lengthens as dd grows; the
     double-contact load shares shift (the new pair enters later)."""
@@ -149,6 +150,7 @@ def test_paper_trends_centre_distance(paper_models):
         assert 0.5 * (2 - eps) < f <= (2 - eps) + 1.5 / 240
 
 
+@pytest.mark.slow
 def test_extended_contact(paper_models):
     """Just after the theoretical end of contact the leaving pair still carries load (extended
     contact under load, which the FE finds and the PEM cannot)."""
@@ -163,6 +165,7 @@ def test_extended_contact(paper_models):
     assert healthy.evaluate(np.array([th]), 0.0)["load_share_exiting"][0] == 0
 
 
+@pytest.mark.slow
 def test_paper_trends_crack(paper_models, paper_case):
     """Fig. 6: the 5 mm crack raises the cracked tooth's compliance and lowers K while the
     cracked tooth is in mesh; elsewhere K is unchanged (within 1 %)."""
@@ -192,6 +195,7 @@ def test_paper_trends_crack(paper_models, paper_case):
     assert strong[1] > strong[0]
 
 
+@pytest.mark.slow
 def test_fe_map_interface(tmp_path, paper_case):
     """fe_map returns a boundary-fitted StiffnessMap with the FE extras and provenance; it
     round-trips through NetCDF; the bodies come from the cache the second time."""

@@ -11,11 +11,14 @@ import math
 from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
+import pytest
 
 from geardyn.cache import Cache
 from geardyn.stiffness import build_map
 from geardyn.stiffness.fe.mesh import CrackGeometry, MeshSettings, build_body_mesh
 
+#: FE meshes and maps built twice (serial and threaded): the slow tier
+pytestmark = pytest.mark.slow
 MESH = MeshSettings(flank_size=0.1e-3, tooth_size=1e-3, body_size=3e-3, refined_teeth=3)
 CRACK = CrackGeometry(depth=5e-3, angle=math.radians(45))
 

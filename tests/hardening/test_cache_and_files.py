@@ -83,9 +83,13 @@ def _cli(*args, cwd=None):
                           text=True, timeout=300, cwd=cwd)
 
 
-SHORT = ["--set", "simulation.record_time=0.005 s", "--set", "simulation.settle_time=0.001 s"]
+#: short records on a coarse PEM map: the files are tested here, not the stiffness method
+SHORT = ["--set", "simulation.record_time=0.005 s", "--set", "simulation.settle_time=0.001 s",
+         "--set", "stiffness.method=pem", "--set", "stiffness.centre_distances=6",
+         "--set", "stiffness.nodes_per_segment=8"]
 
 
+@pytest.mark.slow
 def test_outputs_are_not_overwritten_without_force(tmp_path):
     out = tmp_path / "sim.nc"
     assert _cli("simulate", "--out", str(out), *SHORT).returncode == 0
@@ -96,6 +100,7 @@ def test_outputs_are_not_overwritten_without_force(tmp_path):
     assert _cli("simulate", "--out", str(out), *SHORT, "--force").returncode == 0
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("content", [b"", b"\x89HDF\r\n\x1a\nrubbish", b"not a netcdf file"])
 def test_corrupted_netcdf_input_is_a_clean_error(tmp_path, content):
     bad = tmp_path / "bad.nc"
@@ -105,6 +110,7 @@ def test_corrupted_netcdf_input_is_a_clean_error(tmp_path, content):
     assert "bad.nc" in r.stderr and "Traceback" not in r.stderr
 
 
+@pytest.mark.slow
 def test_truncated_simulation_file_is_a_clean_error(tmp_path):
     out = tmp_path / "sim.nc"
     assert _cli("simulate", "--out", str(out), *SHORT).returncode == 0
@@ -114,6 +120,7 @@ def test_truncated_simulation_file_is_a_clean_error(tmp_path):
     assert r.returncode == 2 and "Traceback" not in r.stderr
 
 
+@pytest.mark.slow
 def test_nothing_in_a_case_or_data_file_is_executed(tmp_path):
     """Python written into case values or pickled objects in data files never runs."""
     marker = tmp_path / "pwned"

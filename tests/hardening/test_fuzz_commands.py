@@ -12,6 +12,7 @@ from __future__ import annotations
 import os
 
 import numpy as np
+import pytest
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 from typer.testing import CliRunner
@@ -23,6 +24,8 @@ from geardyn.errors import GeardynError
 from .test_fuzz_config import check as check_clean
 from .test_fuzz_config import keys, values
 
+#: 300 CLI runs per family (15-50 s each on 2 shared cores): the slow tier
+pytestmark = pytest.mark.slow
 runner = CliRunner()
 #: Examples per family: 300 in the everyday suite and CI (it fits CI's time budget), any number
 #: with ``GEARDYN_FUZZ_EXAMPLES`` (1000 for a thorough run before a release).

@@ -67,6 +67,7 @@ def check(result) -> None:
         assert result.exception is None or isinstance(result.exception, SystemExit)
 
 
+@pytest.mark.slow
 @settings(max_examples=FUZZ_EXAMPLES, deadline=None, suppress_health_check=list(HealthCheck))
 @given(key=keys, value=values)
 def test_geometry_with_fuzzed_overrides(key, value, fuzz_counter):
@@ -82,6 +83,7 @@ def base_text() -> str:
     return case_to_toml(paper_case())
 
 
+@pytest.mark.slow
 @settings(max_examples=FUZZ_EXAMPLES, deadline=None, suppress_health_check=list(HealthCheck))
 @given(data=st.data())
 def test_config_validate_with_fuzzed_files(data, base_text, tmp_path_factory, fuzz_counter):

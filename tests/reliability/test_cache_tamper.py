@@ -149,6 +149,7 @@ def test_stale_temporary_files_are_removed_and_live_ones_kept(case, tmp_path):
     assert not left.exists() and other.exists() and (out / "result.nc").read_bytes() == b"whole"
 
 
+@pytest.mark.slow
 def test_a_cracked_fe_body_copied_over_the_healthy_key_is_rebuilt(tmp_path):
     """The FE body cache (influence coefficients) compares its stored inputs hash with the key.
 

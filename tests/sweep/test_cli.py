@@ -9,6 +9,7 @@ import pytest
 from ._procs import GEARDYN, env
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("args", "words"), [
     (["sweep", "{dir}/bad.toml", "--out", "{dir}/o.zarr"], "axes.crack.depth[1]"),
     (["sweep", "{dir}/good.toml", "--out", "{dir}/o.zarr", "--workers", "2", "--scheduler",
@@ -29,6 +30,7 @@ def test_errors_are_one_line_with_status_2(tmp_path, args, words):
     assert not (tmp_path / "o.zarr").exists()
 
 
+@pytest.mark.slow
 def test_config_and_set_change_the_base_case_and_the_identity(tmp_path):
     """--set overrides reach every run's case, are recorded in the store, and a store made with
     other overrides is not resumed by mistake."""

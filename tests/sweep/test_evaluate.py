@@ -56,6 +56,7 @@ def test_features_equal_the_diagnostics_pipeline():
                                            samples_per_rev=1024).to_dict())
 
 
+@pytest.mark.slow
 def test_evaluate_run_end_to_end():
     from geardyn.dynamics import simulate, summary
     from geardyn.stiffness import build_map
@@ -82,7 +83,7 @@ def test_evaluate_run_end_to_end():
 
 
 def test_map_memo_by_inputs_and_seeded_noise():
-    case = paper_case(SHORT)
+    case = paper_case({**SHORT, "stiffness.method": "pem"})  # the memo is tested, not the FE
     _cached_map.cache_clear()
     m1 = _stiffness_map(case)
     assert _stiffness_map(case.with_overrides({"motor.torque": 80.0})) is m1  # same inputs

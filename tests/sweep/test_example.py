@@ -23,6 +23,7 @@ SWEEP = textwrap.dedent("""
     simulation.settle_time = "0.02 s"
     stiffness.centre_distances = 6
     stiffness.nodes_per_segment = 6
+    stiffness.method = "pem"
     [axes]
     crack.depth = ["1 mm", "3 mm", "5 mm"]
     motor.torque = ["80 N m", "120 N m"]
@@ -32,6 +33,7 @@ SWEEP = textwrap.dedent("""
 """)
 
 
+@pytest.mark.slow
 def test_plot_sweep_example(tmp_path, client):
     store = tmp_path / "small.zarr"
     res = run_sweep(parse_sweep(SWEEP), store, client=client)
