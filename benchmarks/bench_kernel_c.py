@@ -292,8 +292,9 @@ def run(quick: bool) -> list[Row]:
             t_k, t_c = _time_both(setup, static, crun, n)
             rows.append(Row(f"model {which} step, numba kernel vs hand C ({Path(cc).name} -O2; "
                             f"final states agree to {diff:.1e} rel. after {n_check:,} steps)",
-                            t_k, "us/step", "hand C Newmark", t_c, "<= 1.5x the C step",
-                            t_k <= 1.5 * t_c))
+                            t_k, "us/step", "hand C Newmark", t_c,
+                            "<= 1.5x the C step" if which == "II" else "(model II only)",
+                            t_k <= 1.5 * t_c if which == "II" else None))
         return rows
 
 
