@@ -248,9 +248,9 @@ def test_limit_line_cutting_the_tooth_off_is_refused_in_full():
         ToothSection(g, crack, model="classic")
     assert _refusal(exc) == (
         "crack.depth", crack.depth,
-        "a crack whose limit line leaves material in every section up to the tip (a parallel "
-        "limit line beyond the centreline cuts the tooth off; use limit_line='tip' or a "
-        "shorter crack)")
+        "a crack whose limit line leaves material in every section up to the tip (this "
+        "crack's limit line to the tip corner cuts the tooth off; use a shorter or shallower "
+        "crack)")  # a tip limit line is not told to use limit_line='tip' (mutation run)
     ok = ToothSection(g, ToothCrack(depth=10e-3, limit_line="tip"), model="classic")
     y, w, _ = ok.nodes([ok.u_tip])
     assert np.all(w > 0)
@@ -284,3 +284,21 @@ def test_crack_above_the_load_point_changes_nothing():
     assert np.all(sec.load_point(rolls)[0] < yt)
     np.testing.assert_allclose(tooth_compliance(sec, rolls, 2e11, 0.3, 0.02),
                                tooth_compliance(healthy, rolls, 2e11, 0.3, 0.02), rtol=1e-13)
+
+
+@pytest.mark.parametrize(("depth", "angle"), [
+    # the limit line meets the flank between the crack-tip height and the next scan sample
+    (4.792939602694798e-06, 0.2388824205686765),
+    # the limit line meets the flank exactly at a scan sample (f = 0 there)
+    (0.0005845975722696846, 0.5446875722078858),
+])
+def test_kink_of_the_limit_line_is_a_breakpoint_in_the_scan_corner_cases(gear, depth, angle):
+    """Found by mutation testing (docs/mutation.md): in these two cases the section was not cut
+    where the parallel limit line meets the flank, and the Gauss rule integrated across the kink
+    (errors 2.3e-8 and -2.0e-6 against adaptive quad, normally ~1e-12). Oracle: scipy quad."""
+    from geardyn.stiffness.pem import tooth_compliance, tooth_compliance_quad
+
+    sec = ToothSection(gear, ToothCrack(depth=depth, angle=angle, limit_line="parallel"))
+    gauss = float(tooth_compliance(sec, np.array([0.5]), 70e9, 0.3, 0.02)[0])
+    ref = tooth_compliance_quad(sec, 0.5, 70e9, 0.3, 0.02)
+    assert gauss == pytest.approx(ref, rel=1e-10, abs=0.0)

@@ -172,14 +172,26 @@ class ToothSection:
             h, y, _ = self._eval(p, ts)
             f = h - cg.limit_x(y)
             ok = y > cg.tip[1]
+
+            def gap(t, p=p):
+                hh, yy, _ = self._eval(p, np.array([t]))
+                return float(hh[0] - cg.limit_x(yy)[0])
+
             for k in range(ts.size - 1):
-                if ok[k] and ok[k + 1] and f[k] * f[k + 1] < 0:
-                    tc = brentq(lambda t, p=p: float(
-                        self._eval(p, np.array([t]))[0][0]
-                        - cg.limit_x(self._eval(p, np.array([t]))[1])[0]),
-                        ts[k], ts[k + 1], xtol=1e-15, rtol=1e-15)
+                if not ok[k + 1]:
+                    continue
+                a, fa = ts[k], f[k]
+                if not ok[k]:  # the interval straddles the crack tip: scan from the tip up
+                    a = self._param_at(p, float(cg.tip[1]))
+                    fa = gap(a)
+                if fa == 0.0 and ok[k]:  # the limit line meets the flank at a sample
+                    out.append(float(y[k]))
+                elif fa * f[k + 1] < 0:
+                    tc = brentq(gap, a, ts[k + 1], xtol=1e-15, rtol=1e-15)
                     out.append(float(self._eval(p, np.array([tc]))[1][0]))
-        return sorted(y for y in out if self.y_root < y < self.y_tip - 1e-12)
+            if ok[-1] and f[-1] == 0.0:
+                out.append(float(y[-1]))
+        return sorted({y for y in out if self.y_root < y < self.y_tip - 1e-12})
 
     def _split(self, pieces: list[_Piece], breaks: list[float]) -> list[_Piece]:
         out: list[_Piece] = []
@@ -198,10 +210,14 @@ class ToothSection:
             t = p.t0 + (p.t1 - p.t0) * (self._xg + 1) / 2
             h, y, _ = self._eval(p, t)
             if np.any(self.width(y, h) <= 0):
+                why = ("a parallel limit line beyond the centreline cuts the tooth off; use "
+                       "limit_line='tip' or a shorter crack"
+                       if self.crack.limit_line == "parallel" else
+                       "this crack's limit line to the tip corner cuts the tooth off; use a "
+                       "shorter or shallower crack")
                 raise InputError("crack.depth", self.crack.depth,
-                                 "a crack whose limit line leaves material in every section up "
-                                 "to the tip (a parallel limit line beyond the centreline cuts "
-                                 "the tooth off; use limit_line='tip' or a shorter crack)")
+                                 f"a crack whose limit line leaves material in every section up "
+                                 f"to the tip ({why})")
 
     # ------------------------------------------------------------------ quadrature
     def nodes(self, roll: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
