@@ -54,10 +54,17 @@ def test_run_twice_in_the_default_folder_then_other_inputs_refused(tmp_path):
             if "━" in ln]
     assert bars and all(len(ln) <= 80 for ln in bars)
     final = {ln.split("━")[0].strip(): ln.split("━")[-1].split()[0] for ln in bars}
-    assert final["run: simulation"] == "5/5" and final["run: diagnostics"] == "4/4"
-    assert {"run: stiffness (healthy)", "run: stiffness (cracked)", "run: report"} <= set(final)
+    # every bar ends on its own full count
+    assert all(v.split("/")[0] == v.split("/")[-1] for v in final.values()), final
+    assert {"run: stiffness (healthy)", "run: stiffness (cracked)", "run: report",
+            "run: simulation", "run: diagnostics"} <= set(final)
     out = tmp_path / "geardyn-out"
     rec1 = json.loads((out / "inputs.json").read_text())
+    # on a cold cache every simulation is built: the simulation stage's (models I, II, I-static
+    # and the paper's time-step check) and the measurement stage's (with tooth errors)
+    n_sims = rec1["cache"]["simulation"]["built"]
+    assert rec1["cache"]["simulation"]["hits"] == 0
+    assert n_sims >= int(final["run: simulation"].split("/")[1]) >= 5
     assert rec1["complete"] is True and rec1["identity"]["command"] == "run"
     report = (out / "report.html").read_bytes()
     second = run("run", *RUN, cache=cache, cwd=tmp_path)
@@ -76,7 +83,8 @@ def test_run_twice_in_the_default_folder_then_other_inputs_refused(tmp_path):
     rec2 = json.loads((out / "inputs.json").read_text())
     assert rec2["complete"] is True
     assert rec2["cache"]["stiffness"] == {"hits": 2, "built": 0}
-    assert rec2["cache"]["simulation"]["built"] == 0 and rec2["cache"]["simulation"]["hits"] >= 5
+    assert rec2["cache"]["simulation"]["built"] == 0
+    assert n_sims >= rec2["cache"]["simulation"]["hits"] >= int(final["run: simulation"].split("/")[1])
     a = json.loads((out / "summary.json").read_text())
     assert a["complete"] is True
     other = run("run", *RUN, "--set", "simulation.record_time=0.25 s", cache=cache, cwd=tmp_path)

@@ -212,7 +212,9 @@ def _compute(case: Case, sim_case: Case, result: StudyResult, model: str,
             m = chains[noisy].measure(ds["time"].values,
                                       housing_forces(c, result.maps[state], ds),
                                       ds[f"theta_{shaft}"].values, ds[f"omega_{shaft}"].values)
-            tp = tach_pulse_times(m.tach, fs=m.fs)
+            # a record shorter than one revolution holds no pulse edge (a flat tach)
+            tp = (tach_pulse_times(m.tach, fs=m.fs) if np.ptp(m.tach) > 0
+                  else np.empty(0))
             if tp.size < 3:
                 return {"skipped": (
                     f"the measured record ({m.acc.size / m.fs:.3g} s after the chain's lead-in "

@@ -61,7 +61,7 @@ from scipy.interpolate import CubicSpline, RectBivariateSpline
 from ...errors import NumericalError
 from .solve import BodyInfluence
 
-__all__ = ["Candidates", "candidates", "BodyCompliance", "solve_compatibility",
+__all__ = ["Candidates", "candidates", "CandidateGenerator", "BodyCompliance", "solve_compatibility",
            "ContactResult", "PairContactModel"]
 
 PATH, PINION_TIP, GEAR_TIP = 0, 1, 2
@@ -170,6 +170,96 @@ def candidates(pair, theta: float, dd: float, margin: float = 0.35) -> Candidate
     return Candidates(pair=cp.pair, pinion_tooth=cp.pinion_tooth, gear_tooth=cp.gear_tooth, s=s,
                       kind=kind, u1=u1, u2=u2, gap=gap, arm=arm,
                       radius=rho1 * rho2 / (rho1 + rho2))
+
+
+class CandidateGenerator:
+    """:func:`candidates` at many pinion angles of one centre distance.
+
+    The operating geometry, radii and tip roll lengths are computed once per centre distance
+    instead of once per angle; each call repeats the arithmetic of
+    :meth:`geardyn.geometry.GearPair.contact_points` and :func:`candidates` operation for
+    operation, so the result is bit for bit that of ``candidates(pair, theta, dd, margin)``
+    (tests/fe/test_batched_contact.py).
+
+    Parameters
+    ----------
+    pair : geardyn.geometry.GearPair
+    dd : float
+        Centre distance change [m].
+    margin : float
+        Candidates up to ``margin`` base pitches outside the theoretical path.
+    """
+
+    def __init__(self, pair, dd: float, margin: float = 0.35):
+        op = pair.operating(dd, check=False)
+        self.op = op
+        self.pb = pair.base_pitch
+        self.s0 = pair.pitch_point_s
+        self.rb1, self.rb2 = pair.pinion.base_radius, pair.gear.base_radius
+        self.z1, self.z2 = pair.pinion.teeth, pair.gear.teeth
+        self.lo, self.hi = op.s_start - margin * self.pb, op.s_end + margin * self.pb
+        self.t1t2 = op.t1t2
+        self.o2 = np.array([self.rb1 + self.rb2, op.t1t2])
+        self.ua1 = math.sqrt(pair.pinion.tip_radius ** 2 - self.rb1 ** 2)
+        self.ua2 = math.sqrt(pair.gear.tip_radius ** 2 - self.rb2 ** 2)
+
+    def pairs(self, theta: float) -> tuple[np.ndarray, np.ndarray]:
+        """Pair indices ``n`` and LOA positions ``s`` [m] of the candidates at ``theta`` [rad]."""
+        pb = self.pb
+        s_theta = self.s0 + self.rb1 * theta
+        n = np.arange(math.ceil((s_theta - self.hi) / pb - 1e-12),
+                      math.floor((s_theta - self.lo) / pb) + 1)
+        s = s_theta - n * pb
+        order = np.argsort(s)
+        return n[order], s[order]
+
+    def __call__(self, theta: float) -> Candidates:
+        """Candidates at pinion angle ``theta`` [rad]."""
+        return self.complete(*self.pairs(theta))
+
+    def complete(self, n: np.ndarray, s: np.ndarray) -> Candidates:
+        """Candidates of the pairs ``n`` at LOA positions ``s`` [m] (from :meth:`pairs`)."""
+        op, rb1, rb2, t1t2, o2 = self.op, self.rb1, self.rb2, self.t1t2, self.o2
+        ua1, ua2 = self.ua1, self.ua2
+        size = s.size
+        kind = np.where(s > op.s_end, PINION_TIP, np.where(s < op.s_start, GEAR_TIP, PATH))
+        u1 = s.copy()
+        u2 = t1t2 - s
+        gap = np.zeros(size)
+        arm = np.full(size, rb1)
+        for k in range(size):
+            if kind[k] == PINION_TIP:
+                beta = (s[k] - ua1) / rb1
+                c = rb1 * np.array([math.cos(beta), math.sin(beta)]) \
+                    + ua1 * np.array([-math.sin(beta), math.cos(beta)])
+                v = c - o2
+                r = math.hypot(*v)
+                gam = math.atan2(v[1], v[0]) - math.acos(rb2 / r)
+                lam = math.sqrt(r * r - rb2 * rb2)
+                g = lam + rb2 * float(_wrap(gam - math.pi)) - (t1t2 - s[k])
+                gap[k] = g
+                u1[k] = ua1
+                u2[k] = lam - g
+                t2 = o2 + rb2 * np.array([math.cos(gam), math.sin(gam)])
+                e = np.array([-math.sin(gam), math.cos(gam)])
+                arm[k] = abs(t2[0] * e[1] - t2[1] * e[0])
+            elif kind[k] == GEAR_TIP:
+                gn = t1t2 - s[k]
+                gam = math.pi + (gn - ua2) / rb2
+                c = o2 + rb2 * np.array([math.cos(gam), math.sin(gam)]) \
+                    + ua2 * np.array([-math.sin(gam), math.cos(gam)])
+                r = math.hypot(*c)
+                beta = math.atan2(c[1], c[0]) - math.acos(rb1 / r)
+                lam = math.sqrt(r * r - rb1 * rb1)
+                g = lam + rb1 * float(_wrap(beta)) - s[k]
+                gap[k] = g
+                u1[k] = lam - g
+                u2[k] = ua2
+        rho1 = np.clip(u1, 1e-9, None)
+        rho2 = np.clip(u2, 1e-9, None)
+        return Candidates(pair=n, pinion_tooth=np.mod(n, self.z1), gear_tooth=np.mod(n, self.z2),
+                          s=s, kind=kind, u1=u1, u2=u2, gap=gap, arm=arm,
+                          radius=rho1 * rho2 / (rho1 + rho2))
 
 
 class BodyCompliance:
@@ -378,6 +468,13 @@ class PairContactModel:
         if self.cracked is None:
             return False
         teeth = cand.pinion_tooth if self.crack_gear == "pinion" else cand.gear_tooth
+        return self.teeth_involve_crack(teeth)
+
+    def teeth_involve_crack(self, teeth) -> bool:
+        """Whether any of these teeth of the cracked gear is within the cracked body's refined
+        teeth."""
+        if self.cracked is None:
+            return False
         return any(self.cracked.covers(self.model_offset(self.crack_gear, int(t)))
                    for t in teeth)
 

@@ -28,7 +28,8 @@ import numpy as np
 
 from ...errors import DataFileError, InputError
 from ...geometry import Gear
-from .contact import BodyCompliance, PairContactModel, candidates
+from ._batch import solve_compatibility_fast
+from .contact import BodyCompliance, CandidateGenerator, PairContactModel, candidates
 from .mesh import CrackGeometry, MeshSettings, build_body_mesh
 from .solve import (
     BodyInfluence,
@@ -216,6 +217,11 @@ class FEStiffness:
             half_width=self.settings.half_width)
         self.face_width = float(case.pair.face_width)
 
+    #: :meth:`evaluate` with candidates per centre distance (:class:`.contact.CandidateGenerator`)
+    #: and the compiled contact solve (:mod:`._batch`); False: the per-position pure-Python
+    #: reference. Both give the same map bit for bit (tests/fe/test_batched_contact.py).
+    compiled: bool = True
+
     @property
     def torque_per_width(self) -> float:
         """Pinion torque per metre of face width [N m/m]."""
@@ -225,8 +231,17 @@ class FEStiffness:
         """Candidates and :class:`ContactResult` at ``(theta, dd)`` (forces per unit width)."""
         return self.model.solve(theta, dd, self.torque_per_width)
 
-    def evaluate(self, theta: np.ndarray, dd: float) -> dict[str, np.ndarray]:
+    def evaluate(self, theta: np.ndarray, dd: float, *, compiled: bool | None = None
+                 ) -> dict[str, np.ndarray]:
         """Map variables at pinion angles ``theta`` [rad] and change ``dd`` [m].
+
+        ``compiled`` (default :attr:`compiled`): candidates from one
+        :class:`.contact.CandidateGenerator` per centre distance (built only where the cyclic
+        memo misses) and each contact problem solved by the compiled twin
+        :func:`._batch.solve_compatibility_fast`; ``False`` runs today's per-position
+        pure-Python reference (:func:`.contact.candidates`,
+        :meth:`PairContactModel.solve_candidates`). Equal to 1e-9 relative, bit for bit where
+        measured (tests/fe/test_batched_contact.py, benchmarks/bench_fe_eval.py).
 
         Returns
         -------
@@ -239,6 +254,7 @@ class FEStiffness:
             ``transmission_error`` [rad] (pinion hub rotation under the torque).
         """
         theta = np.atleast_1d(np.asarray(theta, float))
+        compiled = self.compiled if compiled is None else bool(compiled)
         pair = self.pair
         rb1, pb = pair.pinion.base_radius, pair.base_pitch
         tm = pair.mesh_angle
@@ -249,15 +265,29 @@ class FEStiffness:
         share = np.zeros((n, 3))
         exiting = np.zeros(n)
         npair = np.zeros(n)
+        gen = CandidateGenerator(pair, dd) if compiled else None
+        zc = pair.gear.teeth if self.model.crack_gear == "gear" else pair.pinion.teeth
         memo: dict[int, tuple] = {}  # healthy teeth: the same result in every mesh cycle
         for i, th in enumerate(theta):
             n_exit = math.floor((pair.pitch_point_s + rb1 * th - s_end) / pb)
             key = round(((th - n_exit * tm) % tm) / tm * 1e9)
-            cand = candidates(pair, th, dd)
-            cyclic = not self.model.involves_crack(cand)
+            if compiled:
+                pn, ps = gen.pairs(th)
+                cracked_teeth = np.mod(pn, zc)
+                cyclic = not self.model.teeth_involve_crack(cracked_teeth)
+            else:
+                cand = candidates(pair, th, dd)
+                cyclic = not self.model.involves_crack(cand)
             hit = memo.get(key) if cyclic else None
             if hit is None:
-                res = self.model.solve_candidates(cand, self.torque_per_width)
+                if compiled:
+                    cand = gen.complete(pn, ps)
+                    res = solve_compatibility_fast(
+                        self.model.compliance(cand), cand.gap, cand.arm, self.torque_per_width,
+                        cand.radius, plane_modulus=(self.model.e1, self.model.e2),
+                        half_width=self.model.half_width, local=self.model.local_enabled)
+                else:
+                    res = self.model.solve_candidates(cand, self.torque_per_width)
                 f = res.force
                 tot = f.sum()
                 shares = tuple((int(p - n_exit), float(x / tot))
