@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+import geardyn
 from geardyn.dynamics import DynamicModel, initial_state, run_steps, simulate, static_equilibrium
 from geardyn.dynamics import _kernel as K
 from geardyn.dynamics.newmark import _setup_for_case, _start_with_errors
@@ -68,9 +69,19 @@ def test_simulate_with_errors_records_the_mesh_error():
 
 
 @pytest.mark.slow
-def test_zero_errors_reproduce_the_records_before_the_excitation_bit_for_bit():
+def test_zero_errors_reproduce_the_records_before_the_excitation():
     """``data/golden_records.npz`` was written by ``_make_golden.py`` with the code before tooth
-    errors existed (commit 917fd3e plus the step-count guard); rerun it there to regenerate."""
+    errors existed (commit 917fd3e plus the step-count guard); rerun it there to regenerate.
+
+    On the machine and library versions that wrote it the records are equal bit for bit. Other
+    NumPy/SciPy builds round the PEM map's integrals differently in the last bit (measured on
+    numpy 2.4.6 / scipy 1.17.1: at most 4e-13 of each signal's peak; the model II residuals,
+    differences of two operating centre distances, by 2.8e-17 m, one unit in the last place of
+    the absolute centre distance), so across machines the records are compared to 1e-12 of each
+    signal's peak, and the residuals to four units in the last place of the centre distance.
+    Equality bit for bit of zero errors with no excitation section in the same process is
+    :func:`test_a_section_of_zeros_equals_no_section`.
+    """
     sys.path.insert(0, str(HERE))
     from _make_golden import records
 
@@ -78,7 +89,12 @@ def test_zero_errors_reproduce_the_records_before_the_excitation_bit_for_bit():
     rec = records()
     assert set(gold.files) == set(rec)
     for k in gold.files:
-        assert np.array_equal(gold[k], rec[k], equal_nan=True), k
+        if k.split("/")[1].startswith("residual"):
+            a = geardyn.paper_case().gear_pair().design_centre_distance  # [m]
+            atol = 4 * np.spacing(a)
+        else:
+            atol = 1e-12 * np.nanmax(np.abs(gold[k]))
+        np.testing.assert_allclose(rec[k], gold[k], rtol=0, atol=atol, err_msg=k)
 
 
 @pytest.mark.slow
