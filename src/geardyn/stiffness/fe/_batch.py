@@ -1,13 +1,23 @@
-r"""Compiled twin of the contact compatibility solve of :mod:`.contact` (issue 16, item 1).
+r"""Compiled twins of the contact computations of :mod:`.contact` (issue 16, item 1).
 
-:func:`solve_compatibility_fast` computes exactly what :func:`.contact.solve_compatibility` with
-the analytical local Hertz term of :meth:`.contact.PairContactModel.local_term` computes: the same
-active-set enumeration order (the previous active set first, then every subset by size in
-lexicographic order), the same acceptance tolerances, the same fixed point and stopping test.
-Only the small dense solves differ in implementation (numba's LAPACK ``gesv`` binding instead of
-NumPy's), which changes results by rounding only; ``tests/fe/test_batched_contact.py`` checks
-the maps against the pure-Python reference to 1e-9 relative. ``fastmath=False``; the
-pure-Python twin is :func:`.contact.solve_compatibility`.
+* :func:`solve_compatibility_fast` (one problem) and :func:`solve_batch` (a block of problems
+  of one size in one call) compute exactly what :func:`.contact.solve_compatibility` with the
+  analytical local Hertz term of :meth:`.contact.PairContactModel.local_term` computes: the same
+  active-set enumeration order (the previous active set first, then every subset by size in
+  lexicographic order), the same acceptance tolerances, the same skip of an exactly singular
+  KKT matrix, the same fixed point and stopping test. The small dense solves call LAPACK
+  ``gesv`` through numba instead of NumPy; given the same inputs the results were equal bit for
+  bit on 1200 positions of the cracked paper map (three centre distances, six mesh cycles around
+  the cracked tooth) when written; the tests allow 1e-9 (tests/fe/test_batched_contact.py).
+* :func:`complete_nb` is :meth:`.contact.CandidateGenerator.complete` (the unloaded gaps, lever
+  arms and roll lengths of the tip-corner contacts) on a block of positions, operation for
+  operation; only ``math.hypot`` differs (numba calls the C library's, Python has its own), so
+  lengths can differ in the last bit.
+
+Used by :meth:`.model.FEStiffness.evaluate` (``compiled=True``); the maps agree with the
+per-position pure-Python reference to 1e-9 relative (tests/fe/test_batched_contact.py; 6e-12
+measured over the cracked paper map, benchmarks/bench_fe_eval.py). ``fastmath=False``
+throughout.
 """
 
 from __future__ import annotations
@@ -20,7 +30,7 @@ from numba import njit
 
 from ...errors import NumericalError
 
-__all__ = ["subset_table", "solve_compatibility_fast"]
+__all__ = ["subset_table", "solve_compatibility_fast", "solve_batch", "complete_nb"]
 
 _TABLES: dict[int, np.ndarray] = {}
 
@@ -63,10 +73,12 @@ def _try(c, g, a, torque, sel, amax, scale_f, f, w):
         mat[k, p] = a[idx[p]]
         rhs[p] = -g[idx[p]]
     rhs[k] = torque
-    # The reference skips an exactly singular KKT matrix (LinAlgError) and tries the next set;
-    # here numba's solve raises instead. With C positive definite and a > 0 the KKT matrix of
-    # every subset is regular, so the two paths never differ on the maps of geardyn's cases.
-    sol = np.linalg.solve(mat, rhs)
+    # Like the reference, an exactly singular KKT matrix (LAPACK gesv reports a zero pivot, where
+    # NumPy raises LinAlgError) skips this set and the enumeration tries the next one.
+    try:
+        sol = np.linalg.solve(mat, rhs)
+    except Exception:  # noqa: BLE001 - numba catches only the bare class
+        return False, 0.0
     for j in range(n):
         f[j] = 0.0
     for p in range(k):
@@ -212,3 +224,137 @@ def solve_compatibility_fast(c0, gap, arm, torque, radius, *, plane_modulus, hal
     if status == 2:
         raise NumericalError("local contact iteration did not converge", state={"rotation": dth})
     return ContactResult(force=f, rotation=float(dth), separation=w, iterations=int(it))
+
+
+@njit(cache=True, fastmath=False)
+def _solve_batch_nb(c0, gap, arm, torque, radius, e1, e2, estar, half_width, local, table,
+                    tol, max_iter):
+    npos, n = gap.shape
+    status = np.zeros(npos, np.int64)
+    force = np.zeros((npos, n))
+    rotation = np.zeros(npos)
+    separation = np.zeros((npos, n))
+    iterations = np.zeros(npos, np.int64)
+    for p in range(npos):
+        st, f, dth, w, it = _solve_nb(c0[p], gap[p], arm[p], torque, radius[p], e1, e2, estar,
+                                      half_width, local, table, tol, max_iter)
+        status[p] = st
+        rotation[p] = dth
+        iterations[p] = it
+        for j in range(n):
+            force[p, j] = f[j]
+            separation[p, j] = w[j]
+    return status, force, rotation, separation, iterations
+
+
+def solve_batch(c0, gap, arm, torque, radius, *, plane_modulus, half_width, local=True,
+                tol=1e-10, max_iter=60):
+    """:func:`solve_compatibility_fast` of many contact problems of one size in one call.
+
+    Parameters
+    ----------
+    c0 : ndarray, shape (p, n, n)
+        Compliances at the reference patch [m^2/N per m].
+    gap, arm, radius : ndarray, shape (p, n)
+        Unloaded gaps [m], pinion lever arms [m], relative radii of curvature [m].
+    torque : float
+        Pinion torque per unit width [N m/m].
+    plane_modulus : (float, float)
+        Plane moduli of the pinion and the gear [Pa].
+    half_width : float
+        Reference patch half-width [m].
+
+    Returns
+    -------
+    status : ndarray of int, shape (p,)
+        0 solved; 1 no active set satisfies the optimality conditions; 2 the local Hertz
+        fixed point did not converge in ``max_iter`` iterations. The caller re-solves the
+        positions with ``status != 0`` by the pure-Python reference (which raises the matching
+        :class:`~geardyn.errors.NumericalError` if it fails too).
+    force : ndarray, shape (p, n)
+        Contact forces per unit width [N/m].
+    rotation : ndarray, shape (p,)
+        Pinion hub rotations [rad].
+    separation : ndarray, shape (p, n)
+        Loaded gaps [m].
+    iterations : ndarray of int, shape (p,)
+        Fixed-point iterations of the local term.
+    """
+    gap = np.ascontiguousarray(gap, float)
+    if gap.ndim != 2:
+        raise ValueError("solve_batch expects gaps of shape (positions, candidates)")
+    e1, e2 = plane_modulus
+    estar = 1.0 / (1.0 / e1 + 1.0 / e2)
+    return _solve_batch_nb(np.ascontiguousarray(c0, float), gap,
+                           np.ascontiguousarray(arm, float), float(torque),
+                           np.ascontiguousarray(radius, float), float(e1), float(e2), estar,
+                           float(half_width), bool(local), subset_table(gap.shape[1]), float(tol),
+                           int(max_iter))
+
+
+@njit(cache=True, fastmath=False)
+def _wrap_angle(a):
+    return (a + math.pi) % (2 * math.pi) - math.pi
+
+
+@njit(cache=True, fastmath=False)
+def complete_nb(s, s_start, s_end, t1t2, o2x, o2y, rb1, rb2, ua1, ua2):
+    """Compiled twin of :meth:`.contact.CandidateGenerator.complete` on a block of positions.
+
+    ``s`` (p, n): LOA positions of the candidates [m]. Returns ``kind, u1, u2, gap, arm,
+    radius`` of shape (p, n) with the operations of the reference in the same order (the
+    reference's ``math.hypot`` is Python's own algorithm, numba's the C library's, so ``r`` may
+    differ from it in the last bit).
+    """
+    npos, n = s.shape
+    kind = np.zeros((npos, n), np.int64)
+    u1 = np.empty((npos, n))
+    u2 = np.empty((npos, n))
+    gap = np.zeros((npos, n))
+    arm = np.empty((npos, n))
+    radius = np.empty((npos, n))
+    for p in range(npos):
+        for k in range(n):
+            sk = s[p, k]
+            a1 = sk
+            a2 = t1t2 - sk
+            g = 0.0
+            lever = rb1
+            if sk > s_end:  # pinion tip corner
+                kind[p, k] = 1
+                beta = (sk - ua1) / rb1
+                cx = rb1 * math.cos(beta) + ua1 * (-math.sin(beta))
+                cy = rb1 * math.sin(beta) + ua1 * math.cos(beta)
+                vx = cx - o2x
+                vy = cy - o2y
+                r = math.hypot(vx, vy)
+                gam = math.atan2(vy, vx) - math.acos(rb2 / r)
+                lam = math.sqrt(r * r - rb2 * rb2)
+                g = lam + rb2 * _wrap_angle(gam - math.pi) - (t1t2 - sk)
+                a1 = ua1
+                a2 = lam - g
+                t2x = o2x + rb2 * math.cos(gam)
+                t2y = o2y + rb2 * math.sin(gam)
+                ex = -math.sin(gam)
+                ey = math.cos(gam)
+                lever = abs(t2x * ey - t2y * ex)
+            elif sk < s_start:  # gear tip corner
+                kind[p, k] = 2
+                gn = t1t2 - sk
+                gam = math.pi + (gn - ua2) / rb2
+                cx = o2x + rb2 * math.cos(gam) + ua2 * (-math.sin(gam))
+                cy = o2y + rb2 * math.sin(gam) + ua2 * math.cos(gam)
+                r = math.hypot(cx, cy)
+                beta = math.atan2(cy, cx) - math.acos(rb1 / r)
+                lam = math.sqrt(r * r - rb1 * rb1)
+                g = lam + rb1 * _wrap_angle(beta) - sk
+                a1 = lam - g
+                a2 = ua2
+            u1[p, k] = a1
+            u2[p, k] = a2
+            gap[p, k] = g
+            arm[p, k] = lever
+            rho1 = max(a1, 1e-9)
+            rho2 = max(a2, 1e-9)
+            radius[p, k] = rho1 * rho2 / (rho1 + rho2)
+    return kind, u1, u2, gap, arm, radius

@@ -71,6 +71,9 @@ PATH, PINION_TIP, GEAR_TIP = 0, 1, 2
 class Candidates:
     """Candidate contacts of the tooth pairs near the mesh at one pinion angle.
 
+    Every field has shape ``(n,)`` for the ``n`` candidates; a block of positions with ``n``
+    candidates each (:meth:`CandidateGenerator.block`) has shape ``(positions, n)``.
+
     Attributes
     ----------
     pair, pinion_tooth, gear_tooth : ndarray of int
@@ -179,7 +182,8 @@ class CandidateGenerator:
     instead of once per angle; each call repeats the arithmetic of
     :meth:`geardyn.geometry.GearPair.contact_points` and :func:`candidates` operation for
     operation, so the result is bit for bit that of ``candidates(pair, theta, dd, margin)``
-    (tests/fe/test_batched_contact.py).
+    (tests/fe/test_batched_contact.py). :meth:`span` and :meth:`block` do the same for many
+    angles at once (the tip-corner geometry compiled, equal to rounding).
 
     Parameters
     ----------
@@ -216,6 +220,41 @@ class CandidateGenerator:
     def __call__(self, theta: float) -> Candidates:
         """Candidates at pinion angle ``theta`` [rad]."""
         return self.complete(*self.pairs(theta))
+
+    def span(self, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """:meth:`pairs` at many angles: ``s_theta`` [m] and the first and last pair index.
+
+        Position ``i`` has the candidates ``n = last[i], last[i] - 1, ..., first[i]`` (in this,
+        :meth:`pairs`' order of increasing ``s``) at ``s = s_theta[i] - n p_b``; the same
+        floating-point operations as :meth:`pairs`, element by element.
+        """
+        pb = self.pb
+        s_theta = self.s0 + self.rb1 * np.asarray(theta, float)
+        first = np.ceil((s_theta - self.hi) / pb - 1e-12).astype(np.int64)
+        last = np.floor((s_theta - self.lo) / pb).astype(np.int64)
+        return s_theta, first, last
+
+    def block(self, s_theta: np.ndarray, last: np.ndarray, size: int) -> Candidates:
+        """Candidates of positions with ``size`` candidates each, from :meth:`span`.
+
+        Returns
+        -------
+        Candidates
+            Every field of shape ``(positions, size)``, row ``i`` equal to
+            ``self(theta[i])`` (the geometry of the tip corners computed by the compiled
+            :func:`._batch.complete_nb`).
+        """
+        from ._batch import complete_nb
+
+        n = np.asarray(last, np.int64)[:, None] - np.arange(size, dtype=np.int64)[None, :]
+        s = np.asarray(s_theta, float)[:, None] - n * self.pb
+        op = self.op
+        kind, u1, u2, gap, arm, radius = complete_nb(
+            s, float(op.s_start), float(op.s_end), float(self.t1t2), float(self.o2[0]),
+            float(self.o2[1]), float(self.rb1), float(self.rb2), float(self.ua1),
+            float(self.ua2))
+        return Candidates(pair=n, pinion_tooth=np.mod(n, self.z1), gear_tooth=np.mod(n, self.z2),
+                          s=s, kind=kind, u1=u1, u2=u2, gap=gap, arm=arm, radius=radius)
 
     def complete(self, n: np.ndarray, s: np.ndarray) -> Candidates:
         """Candidates of the pairs ``n`` at LOA positions ``s`` [m] (from :meth:`pairs`)."""
@@ -293,6 +332,35 @@ class BodyCompliance:
     def covers(self, offset: int) -> bool:
         """Whether model tooth ``offset`` is loaded in this body's model (cracked bodies)."""
         return offset in self.inf.load_offsets
+
+    def batch(self, load: np.ndarray, u_load: np.ndarray, read: np.ndarray,
+              u_read: np.ndarray) -> np.ndarray:
+        """:meth:`__call__` element by element on arrays of one shape [m^2/N].
+
+        Entries sharing a spline are evaluated in one vectorised call of it (the same spline
+        arithmetic as the scalar call; equal bit for bit, tests/fe/test_batched_contact.py).
+        """
+        load = np.asarray(load, np.int64)
+        read = np.asarray(read, np.int64)
+        ul = np.clip(u_load, self.u_min, self.u_max)
+        ur = np.clip(u_read, self.u_min, self.u_max)
+        if self.cyclic:
+            read, load = read - load, np.zeros_like(load)
+        out = np.zeros(ul.shape)
+        if out.size == 0:
+            return out
+        base = int(max(np.max(np.abs(load)), np.max(np.abs(read)))) + 1
+        code = (load + base) * (2 * base + 1) + (read + base)
+        for c in np.unique(code):
+            sel = code == c
+            i, j = int(c // (2 * base + 1) - base), int(c % (2 * base + 1) - base)
+            if i == j:
+                out[sel] = self._self[i](ul[sel])
+            else:
+                f = self._cross.get((i, j))
+                if f is not None:
+                    out[sel] = f.ev(ur[sel], ul[sel])
+        return out
 
     def __call__(self, load: int, u_load: float, read: int, u_read: float) -> float:
         """Compliance [m^2/N]: displacement at ``u_read`` on model tooth ``read`` per unit load at
@@ -493,6 +561,51 @@ class PairContactModel:
                     out[j, k] = healthy(0, u[k], self._wrap(m[j] - m[k], z), u[j])
         # Maxwell-Betti: the patch-to-point coefficients are symmetric up to discretisation
         return 0.5 * (out + out.T)
+
+    def _side_batch(self, which: str, teeth: np.ndarray, u: np.ndarray) -> np.ndarray:
+        z = self.pair.pinion.teeth if which == "pinion" else self.pair.gear.teeth
+        sign = -1 if which == "pinion" else 1
+        ref = self.crack_tooth if (self.cracked is not None and which == self.crack_gear) else 0
+        healthy = self.pinion if which == "pinion" else self.gear
+        cracked = self.cracked if which == self.crack_gear else None
+        m = sign * ((np.asarray(teeth, np.int64) - ref + z // 2) % z - z // 2)
+        npos, n = m.shape
+        shape = (npos, n, n)
+        mk = np.broadcast_to(m[:, None, :], shape)  # load on candidate k (column)
+        mj = np.broadcast_to(m[:, :, None], shape)  # read on candidate j (row)
+        uk = np.broadcast_to(u[:, None, :], shape)
+        uj = np.broadcast_to(u[:, :, None], shape)
+        out = np.zeros(shape)
+        if cracked is not None:
+            cov = np.isin(m, cracked.inf.load_offsets)
+            use = cov[:, None, :] & cov[:, :, None]
+        else:
+            use = np.zeros(shape, bool)
+        if use.any():
+            out[use] = cracked.batch(mk[use], uk[use], mj[use], uj[use])
+        rest = ~use
+        rel = (mj[rest] - mk[rest] + z // 2) % z - z // 2
+        out[rest] = healthy.batch(np.zeros_like(rel), uk[rest], rel, uj[rest])
+        return 0.5 * (out + np.swapaxes(out, 1, 2))
+
+    def compliance_batch(self, cand: Candidates) -> np.ndarray:
+        """:meth:`compliance` of a block of positions (every field of ``cand`` of shape
+        ``(positions, n)``, e.g. from :meth:`CandidateGenerator.block`), shape
+        ``(positions, n, n)`` [m^2/N per m]; each matrix equal bit for bit to
+        :meth:`compliance` of that row."""
+        return self._side_batch("pinion", cand.pinion_tooth, cand.u1) + \
+            self._side_batch("gear", cand.gear_tooth, cand.u2)
+
+    def crack_rows(self, pair_index: np.ndarray, valid: np.ndarray) -> np.ndarray:
+        """:meth:`involves_crack` of many positions: pair indices ``n`` (positions, k) of which
+        ``valid`` entries are candidates -> bool (positions,)."""
+        if self.cracked is None:
+            return np.zeros(pair_index.shape[0], bool)
+        z = self.pair.pinion.teeth if self.crack_gear == "pinion" else self.pair.gear.teeth
+        sign = -1 if self.crack_gear == "pinion" else 1
+        teeth = np.mod(pair_index, z)
+        m = sign * ((teeth - self.crack_tooth + z // 2) % z - z // 2)
+        return np.any(np.isin(m, self.cracked.inf.load_offsets) & valid, axis=1)
 
     def compliance(self, cand: Candidates) -> np.ndarray:
         """Compliance matrix of the candidates at the reference patch width [m^2/N per m]."""

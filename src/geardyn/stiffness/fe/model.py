@@ -28,8 +28,14 @@ import numpy as np
 
 from ...errors import DataFileError, InputError
 from ...geometry import Gear
-from ._batch import solve_compatibility_fast
-from .contact import BodyCompliance, CandidateGenerator, PairContactModel, candidates
+from ._batch import solve_batch
+from .contact import (
+    BodyCompliance,
+    CandidateGenerator,
+    Candidates,
+    PairContactModel,
+    candidates,
+)
 from .mesh import CrackGeometry, MeshSettings, build_body_mesh
 from .solve import (
     BodyInfluence,
@@ -165,6 +171,11 @@ def _crack_of(case, cracked: bool) -> CrackGeometry | None:
     return CrackGeometry(depth=float(c.depth), angle=float(c.angle))
 
 
+def _row(cand: Candidates, q: int) -> Candidates:
+    """Position ``q`` of a block of candidates (:meth:`.contact.CandidateGenerator.block`)."""
+    return Candidates(**{k: getattr(cand, k)[q] for k in Candidates.__dataclass_fields__})
+
+
 class FEStiffness:
     """FE mesh stiffness of a case at any pinion angle and centre distance change.
 
@@ -217,9 +228,11 @@ class FEStiffness:
             half_width=self.settings.half_width)
         self.face_width = float(case.pair.face_width)
 
-    #: :meth:`evaluate` with candidates per centre distance (:class:`.contact.CandidateGenerator`)
-    #: and the compiled contact solve (:mod:`._batch`); False: the per-position pure-Python
-    #: reference. Both give the same map bit for bit (tests/fe/test_batched_contact.py).
+    #: :meth:`evaluate` batched over the positions of one centre distance (candidates,
+    #: compliances and contact problems each in a few vectorised or compiled calls,
+    #: :meth:`_evaluate_batched`); False: the per-position pure-Python reference. Both give the
+    #: same map to 1e-9 relative (tests/fe/test_batched_contact.py; 6e-12 measured on the
+    #: cracked paper map, from last-bit differences of ``math.hypot`` in the tip-corner gaps).
     compiled: bool = True
 
     @property
@@ -235,13 +248,15 @@ class FEStiffness:
                  ) -> dict[str, np.ndarray]:
         """Map variables at pinion angles ``theta`` [rad] and change ``dd`` [m].
 
-        ``compiled`` (default :attr:`compiled`): candidates from one
-        :class:`.contact.CandidateGenerator` per centre distance (built only where the cyclic
-        memo misses) and each contact problem solved by the compiled twin
-        :func:`._batch.solve_compatibility_fast`; ``False`` runs today's per-position
-        pure-Python reference (:func:`.contact.candidates`,
-        :meth:`PairContactModel.solve_candidates`). Equal to 1e-9 relative, bit for bit where
-        measured (tests/fe/test_batched_contact.py, benchmarks/bench_fe_eval.py).
+        ``compiled`` (default :attr:`compiled`): all positions of this centre distance at once
+        (:meth:`_evaluate_batched`); ``False`` runs the per-position pure-Python reference
+        (:func:`.contact.candidates`, :meth:`PairContactModel.solve_candidates`). Equal to 1e-9
+        relative (tests/fe/test_batched_contact.py; at most 6e-12 measured over the cracked
+        paper map, benchmarks/bench_fe_eval.py).
+
+        Healthy teeth give the same result in every mesh cycle: a position whose candidates
+        involve no tooth of the cracked body reuses the result of the first such position at the
+        same phase of the mesh cycle (to 1e-9 of a cycle).
 
         Returns
         -------
@@ -255,6 +270,8 @@ class FEStiffness:
         """
         theta = np.atleast_1d(np.asarray(theta, float))
         compiled = self.compiled if compiled is None else bool(compiled)
+        if compiled:
+            return self._evaluate_batched(theta, float(dd))
         pair = self.pair
         rb1, pb = pair.pinion.base_radius, pair.base_pitch
         tm = pair.mesh_angle
@@ -265,29 +282,15 @@ class FEStiffness:
         share = np.zeros((n, 3))
         exiting = np.zeros(n)
         npair = np.zeros(n)
-        gen = CandidateGenerator(pair, dd) if compiled else None
-        zc = pair.gear.teeth if self.model.crack_gear == "gear" else pair.pinion.teeth
         memo: dict[int, tuple] = {}  # healthy teeth: the same result in every mesh cycle
         for i, th in enumerate(theta):
             n_exit = math.floor((pair.pitch_point_s + rb1 * th - s_end) / pb)
             key = round(((th - n_exit * tm) % tm) / tm * 1e9)
-            if compiled:
-                pn, ps = gen.pairs(th)
-                cracked_teeth = np.mod(pn, zc)
-                cyclic = not self.model.teeth_involve_crack(cracked_teeth)
-            else:
-                cand = candidates(pair, th, dd)
-                cyclic = not self.model.involves_crack(cand)
+            cand = candidates(pair, th, dd)
+            cyclic = not self.model.involves_crack(cand)
             hit = memo.get(key) if cyclic else None
             if hit is None:
-                if compiled:
-                    cand = gen.complete(pn, ps)
-                    res = solve_compatibility_fast(
-                        self.model.compliance(cand), cand.gap, cand.arm, self.torque_per_width,
-                        cand.radius, plane_modulus=(self.model.e1, self.model.e2),
-                        half_width=self.model.half_width, local=self.model.local_enabled)
-                else:
-                    res = self.model.solve_candidates(cand, self.torque_per_width)
+                res = self.model.solve_candidates(cand, self.torque_per_width)
                 f = res.force
                 tot = f.sum()
                 shares = tuple((int(p - n_exit), float(x / tot))
@@ -306,6 +309,73 @@ class FEStiffness:
             npair[i] = npc
         return {"k_mb": k_mb, "load_share": share, "load_share_exiting": exiting,
                 "pairs_in_contact": npair, "transmission_error": te}
+
+    def _evaluate_batched(self, theta: np.ndarray, dd: float) -> dict[str, np.ndarray]:
+        """:meth:`evaluate` of all positions of one centre distance in a few batched calls.
+
+        The reference's arithmetic, reorganised: (1) the candidate pair indices of every
+        position (:meth:`.contact.CandidateGenerator.span`) and the mesh-cycle memo decided up
+        front (which positions involve the cracked body, which are the first at their phase);
+        (2) for the positions to solve, grouped by their number of candidates, the candidate
+        geometry (compiled :func:`._batch.complete_nb`), the compliance matrices (one vectorised
+        spline call per pair of model teeth, :meth:`.contact.PairContactModel.compliance_batch`)
+        and the contact problems (compiled :func:`._batch.solve_batch`); (3) load shares and
+        the memo's copies as array operations. A position the compiled solve does not resolve
+        (``status != 0``) falls back to :meth:`.contact.PairContactModel.solve_candidates`,
+        which solves it or raises :class:`~geardyn.errors.NumericalError`.
+        """
+        pair = self.pair
+        cm = self.model
+        rb1, pb = pair.pinion.base_radius, pair.base_pitch
+        tm = pair.mesh_angle
+        s_end = pair.operating(dd, check=False).s_end
+        torque = self.torque_per_width
+        npos = theta.size
+        gen = CandidateGenerator(pair, dd)
+        s_theta, first, last = gen.span(theta)
+        count = last - first + 1
+        n_exit = np.floor((pair.pitch_point_s + rb1 * theta - s_end) / pb).astype(np.int64)
+        key = np.round(((theta - n_exit * tm) % tm) / tm * 1e9).astype(np.int64)
+        width = int(count.max()) if npos else 0
+        cols = np.arange(width)
+        cyclic = ~cm.crack_rows(last[:, None] - cols[None, :], cols[None, :] < count[:, None])
+        # the memo: a cyclic position takes the result of the first cyclic one with its key
+        src = np.arange(npos)
+        cyc = np.nonzero(cyclic)[0]
+        if cyc.size:
+            _, first_at, inverse = np.unique(key[cyc], return_index=True, return_inverse=True)
+            src[cyc] = cyc[first_at][inverse.ravel()]
+        solved = np.unique(src)
+        rot = np.empty(npos)
+        share = np.zeros((npos, 3))
+        exiting = np.zeros(npos)
+        npair = np.zeros(npos)
+        for size in np.unique(count[solved]):
+            rows = solved[count[solved] == size]
+            cand = gen.block(s_theta[rows], last[rows], int(size))
+            c0 = cm.compliance_batch(cand)
+            status, f, dth, _, _ = solve_batch(
+                c0, cand.gap, cand.arm, torque, cand.radius, plane_modulus=(cm.e1, cm.e2),
+                half_width=cm.half_width, local=cm.local_enabled)
+            for q in np.nonzero(status)[0]:  # fallback: the pure-Python reference
+                res = cm.solve_candidates(_row(cand, int(q)), torque)
+                f[q] = res.force
+                dth[q] = res.rotation
+            tot = f.sum(axis=1)
+            rel = cand.pair - n_exit[rows][:, None]
+            x = f / tot[:, None]
+            for k in range(int(size)):
+                r = rel[:, k]
+                slot = (r >= 1) & (r <= 3)
+                share[rows[slot], r[slot] - 1] = x[slot, k]
+                ex = r == 0
+                exiting[rows[ex]] = x[ex, k]
+            rot[rows] = dth
+            npair[rows] = np.sum(f > 1e-9 * tot[:, None], axis=1)
+        te = rot[src]
+        return {"k_mb": self.settings.torque / te / rb1 ** 2, "load_share": share[src],
+                "load_share_exiting": exiting[src], "pairs_in_contact": npair[src],
+                "transmission_error": te}
 
     def attrs(self) -> dict:
         """Provenance of maps made by this model."""
