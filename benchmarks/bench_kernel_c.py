@@ -79,8 +79,41 @@ static double lookup(double theta, double dd, double dd0, double ddd, const doub
     return v1 * (1.0 - w) + v2 * w;
 }
 
+/* the map averaged over [theta - h, theta + h], split at the nearest handover (lookup_box) */
+static double lookup_box(double theta, double h, double dd, double dd0, double ddd,
+                         const double *pa, const double *la_, double tm, long nc, long ns,
+                         long nd, const double *v)
+{
+    if (!(h > 0.0)) return lookup(theta, dd, dd0, ddd, pa, la_, tm, nc, ns, nd, v);
+    double a, la;
+    if (nd == 1) { a = pa[0]; la = la_[0]; }
+    else {
+        double x = (dd - dd0) / ddd;
+        if (x < -1e-9 || x > (nd - 1) + 1e-9) return NAN;
+        long i = (long)floor(x);
+        if (i < 0) i = 0;
+        if (i > nd - 2) i = nd - 2;
+        double w = x - i;
+        if (w < 0.0) w = 0.0;
+        if (w > 1.0) w = 1.0;
+        a = pa[i] + w * (pa[i + 1] - pa[i]);
+        la = la_[i] + w * (la_[i + 1] - la_[i]);
+    }
+    double r = fmod(theta - a, tm);
+    if (r < 0.0) r += tm;
+    double tb = NAN, dist = h;
+    if (r < dist) { tb = theta - r; dist = r; }
+    if (tm - r < dist) { tb = theta + (tm - r); dist = tm - r; }
+    if (la > 1e-12 * tm && fabs(r - la) < dist) tb = theta - (r - la);
+    if (tb != tb) return lookup(theta, dd, dd0, ddd, pa, la_, tm, nc, ns, nd, v);
+    double lo = theta - h, hi = theta + h;
+    double vl = lookup(0.5 * (lo + tb), dd, dd0, ddd, pa, la_, tm, nc, ns, nd, v);
+    double vr = lookup(0.5 * (tb + hi), dd, dd0, ddd, pa, la_, tm, nc, ns, nd, v);
+    return ((tb - lo) * vl + (hi - tb) * vr) / (2.0 * h);
+}
+
 /* fp: dt beta gamma alpha qmb rsum t1t2 d0 tol rtol hstep sigma unorm;
-   ip: model2 ev_start maxit sep n_steps
+   ip: model2 ev_start maxit sep n_steps window
    st: z[6] v[6] a[6] n_force; returns 0 or the failing step (1-based). */
 long advance(const double *fp, const long *ip, const double *M, const double *Sinv,
              const double *SK, const double *SC, const double *sQ, const double *u,
@@ -93,6 +126,7 @@ long advance(const double *fp, const long *ip, const double *M, const double *Si
     double sigma = fp[11], unorm = fp[12], plim = fp[13], ylim = fp[14];
     int model2 = ip[0] != 0, ev_start = ip[1] != 0, sep = ip[3] != 0;
     long maxit = ip[2], n_steps = ip[4];
+    int window = ip[5] != 0;
     double opa = 1.0 + al, bdt2 = beta * dt * dt, gdt = gam * dt, period = nc * tm;
     double *z = st, *v = st + 6, *a = st + 12;
     double xt[6], vt[6], w[6], an[6], ap[6];
@@ -124,12 +158,13 @@ long advance(const double *fp, const long *ip, const double *M, const double *Si
             ype = z[1] + dt * v[1] + 0.5 * dt * dt * a[1];
             yge = z[3] + dt * v[3] + 0.5 * dt * dt * a[3];
         }
+        double hbox = window ? 0.5 * fabs(hstep + dt * v[2]) : 0.0;
         double b1 = d0;
         if (model2) { double e = t1t2 + yge - ype; b1 = sqrt(rsum * rsum + e * e); }
         long it = 0; double res = NAN, kk = 0.0, nf = 0.0, b2 = d0;
         double b2m1 = NAN, b2m2 = NAN, kfirst = 0.0, km1 = 0.0; int take_next = 0;
         for (;;) {
-            kk = lookup(th, b1 - d0, dd0, ddd, pa, la, tm, nc, ns, nd, kv);
+            kk = lookup_box(th, hbox, b1 - d0, dd0, ddd, pa, la, tm, nc, ns, nd, kv);
             if (kk != kk) return n + 1;
             if (it == 0) kfirst = kk;
             if (hh > 0.0) {
@@ -215,7 +250,8 @@ class _CRunner:
                             fp[K.FP_TOL], fp[K.FP_RTOL], fp[K.FP_HSTEP], fp[K.FP_SIGMA],
                             fp[K.FP_UNORM], fp[K.FP_PLIM], fp[K.FP_YLIM]])
         self.ip = np.array([int(ip[K.IP_MODEL] == 2), int(ip[K.IP_EVAL] == 1),
-                            int(ip[K.IP_MAXIT]), int(ip[K.IP_SEP]), 0], dtype=np.int64)
+                            int(ip[K.IP_MAXIT]), int(ip[K.IP_SEP]), 0,
+                            int(ip[K.IP_WINDOW])], dtype=np.int64)
         m = setup.map_arrays
         self.mats = [np.ascontiguousarray(x, dtype=float) for x in
                      (setup.M, setup.Sinv, setup.SK, setup.SC, setup.sQ, setup.u, setup.g)]

@@ -364,6 +364,12 @@ class SimulationConfig(_Model):
     stiffness_evaluation: Literal["predictor", "start"] = Field(
         "predictor", description="Model II: stiffness at the Newmark predictor (2nd order) or at "
                                  "the start of the step (the paper's flow chart, 1st order).")
+    stiffness_window: Literal["step", "point"] = Field(
+        "step", description="Mesh stiffness in each step: 'step' averages the map over the "
+                            "step's rotation (a contact handover inside a step counts for the "
+                            "part of the step after it; removes the handover-timing jitter that "
+                            "otherwise shows in a healthy gear's TSA residual), 'point' samples "
+                            "it at the evaluation angle (the paper's flow chart).")
     integrator: Literal["newmark", "hht"] = Field("newmark", description="Average-acceleration "
                                                                          "Newmark or HHT-alpha.")
     hht_alpha: float = Field(-0.05, ge=-1 / 3, le=0, description="HHT alpha in [-1/3, 0].")

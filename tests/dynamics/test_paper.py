@@ -89,7 +89,10 @@ def test_model_ii_iterates_only_at_handovers_and_the_crack(runs, case, pem):
     it = tight.iterations.values
     assert 0.002 < np.mean(it > 0) < 0.05
     assert _handover_distance_steps(tight, pem)[it > 0].max() <= 1.5
-    assert np.abs(tight.transmission_error.values - ds.transmission_error.values).max() < 1e-8
+    # the tighter tolerance changes the transmission error by less than 0.1 % of its STD
+    # (measured 0.06 %, 2.0e-8 rad, with the step-averaged stiffness; < 1e-8 rad point-sampled)
+    te = ds.transmission_error.values
+    assert np.abs(tight.transmission_error.values - te).max() < 1e-3 * np.std(te)
 
 
 def test_paper_flow_chart_iterates_where_the_centre_distance_moves(case, pem):
@@ -138,7 +141,8 @@ def test_halved_mesh_stiffness_keeps_the_checks_and_fails_the_comparison(case, p
 
 
 def test_handover_inside_a_step_has_no_fixed_point_and_is_accepted(pem):
-    """At 170 N m and tol = 1e-8 m some steps' handover lies between the two centre distances
+    """Stiffness sampled at a point: at 170 N m and tol = 1e-8 m some steps' handover lies
+    between the two centre distances
     the iteration visits (higher k moves the handover past theta, lower k moves it back): no
     fixed point exists. Those steps are accepted on the first solve's side after a detected
     two-cycle (the run used to stop with 'did not converge' at 0.243 s), they sit at handovers,
@@ -148,7 +152,12 @@ def test_handover_inside_a_step_has_no_fixed_point_and_is_accepted(pem):
     from geardyn.dynamics.newmark import _setup_for_case
 
     c = geardyn.paper_case({"simulation.settle_time": 0.0, "simulation.record_time": 0.25,
-                            "simulation.tolerance": 1e-8, "motor.torque": 170.0})
+                            "simulation.tolerance": 1e-8, "motor.torque": 170.0,
+                            "simulation.stiffness_window": "point"})
+    # averaged over each step's rotation (the default) the stiffness is continuous in d and
+    # every step has its fixed point
+    assert simulate(c.with_overrides({"simulation.stiffness_window": "step"}), pem,
+                    model="II").attrs["steps_without_fixed_point"] == 0
     ds = simulate(c, pem, model="II")
     ra = ds.residual_after.values
     stuck = ra >= 1e-8

@@ -89,7 +89,7 @@ import math
 import numba
 import numpy as np
 
-from ..stiffness.map import lookup, lookup_reference
+from ..stiffness.map import lookup_box, lookup_box_reference
 
 __all__ = ["advance", "advance_python", "law_torque", "STATUS_TEXT", "N_STATE", "N_FP", "N_IP",
            "N_REC", "N_FAIL", "N_EIP", "N_EFP", "no_excitation"]
@@ -105,7 +105,8 @@ FP_DRIVE_GAIN, FP_WREF = 31, 32  # speed-controlled drive following a speed prof
 N_FP = 33
 # integer parameters
 IP_MODEL, IP_EVAL, IP_MAXIT, IP_SEP, IP_INLAW, IP_OUTLAW, IP_IN_NL, IP_OUT_NL = range(8)
-N_IP = 8
+IP_WINDOW = 8  # 1: the stiffness averaged over each step's rotation (map.lookup_box)
+N_IP = 9
 # state
 S_Z, S_V, S_A = 0, 6, 12
 S_N, S_K, S_H, S_DD, S_IT, S_RB, S_RA, S_QIN, S_QOUT = 18, 19, 20, 21, 22, 23, 24, 25, 26
@@ -401,6 +402,7 @@ def advance(n_steps, rec_start, decim, out, j, st, ist, fail,
     model2 = ip[IP_MODEL] == 2
     ev_start = ip[IP_EVAL] == 1
     maxit = ip[IP_MAXIT]
+    box = ip[IP_WINDOW] == 1
     sep = ip[IP_SEP] == 1
     in_nl = ip[IP_IN_NL] == 1
     out_nl = ip[IP_OUT_NL] == 1
@@ -483,6 +485,8 @@ def advance(n_steps, rec_start, decim, out, j, st, ist, fail,
             b1 = math.sqrt(rsum * rsum + e * e)
         else:
             b1 = d0
+        # half the rotation of this step: the window of the stiffness average (lookup_box)
+        hbox = 0.5 * abs(hstep + dt * st[S_V + 2]) if box else 0.0
         # ---- tooth errors: e_bar, the loaded pairs' share and the pattern's angle
         th_k = th
         ebar = 0.0
@@ -511,11 +515,11 @@ def advance(n_steps, rec_start, decim, out, j, st, ist, fail,
         take_next = False
         status = OK
         while True:
-            if it == 0 and k_pre == k_pre:  # found with the load shares at the same point
+            if it == 0 and k_pre == k_pre and hbox <= 0.0:  # found with the shares there
                 kk = k_pre
             else:
-                kk = lookup(th_k, b1 - d0, dd0, ddd, phase_a, length_a, mesh_angle, n_cycles,
-                            n_seg, kvals)
+                kk = lookup_box(th_k, hbox, b1 - d0, dd0, ddd, phase_a, length_a, mesh_angle,
+                                n_cycles, n_seg, kvals)
             if kk != kk:
                 status = MAP_RANGE
                 break
@@ -819,11 +823,12 @@ def advance_python(n_steps, rec_start, decim, out, j, st, ist, fail,
             th_k, ebar, frac, hh = _excite_py(th, tha, b1, rsum, b1 - d0,
                                               g @ (xt + beta * dt * dt * a_free), sep, eip, efp,
                                               etp, etg, els, arrays)
+        hbox = 0.5 * abs(hstep + dt * v[2]) if ip[IP_WINDOW] == 1 else 0.0
         it, res_b, res, a_prev = 0, np.nan, np.nan, None
         history_b2, history_k, take_next = [], [], False
         status = OK
         while True:
-            kk = float(lookup_reference(np.array(th_k), np.array(b1 - d0), arrays))
+            kk = lookup_box_reference(th_k, hbox, b1 - d0, arrays)
             if np.isnan(kk):
                 status = MAP_RANGE
                 nf = 0.0

@@ -103,7 +103,7 @@ def make_setup(M, K0, C, g, Q0, stiffness_map: StiffnessMap | MapArrays, *, dt: 
                input_speed: float = 0.0, output_speed: float = 0.0,
                excitation: tuple | None = None,
                ripple: tuple[float, float, float] = (0.0, 1.0, 0.0),
-               drive: tuple | None = None) -> KernelSetup:
+               drive: tuple | None = None, stiffness_window: str = "step") -> KernelSetup:
     r"""Arrays for the kernel from a general 6-DOF system in deviation coordinates.
 
     The system is ``M z'' + C z' + K0 z + N g = Q0 + q(z')``, ``N = h (k p + q_mb p')``,
@@ -156,6 +156,12 @@ def make_setup(M, K0, C, g, Q0, stiffness_map: StiffnessMap | MapArrays, *, dt: 
         Speed-controlled drive: adds ``gain (w_target(t) - w_ref)`` [N m] to DOF 0, with
         ``w_target`` piecewise linear in ``(times [s], speeds [rad/s])``; the drive's slope
         ``-gain`` must already be in ``C[0, 0]``.
+    stiffness_window : {"step", "point"}
+        ``"step"`` (default): the map averaged over each step's rotation
+        (:func:`geardyn.stiffness.map.lookup_box`), so a contact handover inside a step enters
+        in proportion to the part of the step after it instead of at the step's end;
+        ``"point"``: the map at the evaluation angle (geardyn before 2026-11-25, and the
+        paper's flow chart).
     """
     if model not in ("I", "II"):
         raise InputError("simulation.model", model, "'I' or 'II'")
@@ -163,6 +169,8 @@ def make_setup(M, K0, C, g, Q0, stiffness_map: StiffnessMap | MapArrays, *, dt: 
         raise InputError("simulation.stiffness_evaluation", evaluation, "'predictor' or 'start'")
     if integrator not in ("newmark", "hht"):
         raise InputError("simulation.integrator", integrator, "'newmark' or 'hht'")
+    if stiffness_window not in ("step", "point"):
+        raise InputError("simulation.stiffness_window", stiffness_window, "'step' or 'point'")
     al = float(hht_alpha) if integrator == "hht" else 0.0
     if not -1.0 / 3.0 <= al <= 0.0:
         raise InputError("simulation.hht_alpha", hht_alpha, "a value in [-1/3, 0]")
@@ -202,6 +210,7 @@ def make_setup(M, K0, C, g, Q0, stiffness_map: StiffnessMap | MapArrays, *, dt: 
     ip[K.IP_SEP] = int(bool(separation))
     ip[K.IP_INLAW], ip[K.IP_OUTLAW] = laws[0][0].code, laws[1][0].code
     ip[K.IP_IN_NL], ip[K.IP_OUT_NL] = int(laws[0][0].nonlinear), int(laws[1][0].nonlinear)
+    ip[K.IP_WINDOW] = int(stiffness_window == "step")
     return KernelSetup(M=M, K0=K0, C=C, Q0=Q0, Sinv=Sinv, SK=np.ascontiguousarray(Sinv @ K0),
                        SC=np.ascontiguousarray(Sinv @ C), sQ=np.ascontiguousarray(Sinv @ Q0),
                        u=np.ascontiguousarray(u), g=g, fp=fp, ip=ip, map_arrays=arrays,
@@ -324,7 +333,8 @@ def _setup_for_case(case, dyn: DynamicModel, stiffness_map: StiffnessMap, which:
         d0 = pair.design_centre_distance + static.centre_distance_change
     return make_setup(
         dyn.M, dyn.K0, C, dyn.g, Q0, kernel_map, dt=sim.dt, model="II" if which == "II" else "I",
-        evaluation=sim.stiffness_evaluation, integrator=sim.integrator, hht_alpha=sim.hht_alpha,
+        evaluation=sim.stiffness_evaluation, stiffness_window=sim.stiffness_window,
+        integrator=sim.integrator, hht_alpha=sim.hht_alpha,
         q_mb=dyn.q_mb, rsum=pair.base_radius_sum, t1t2=pair.design_t1t2,
         d0=d0, tolerance=sim.tolerance, rtol=sim.rtol,
         max_iterations=sim.max_iterations, speed=dyn.speed, p_lim=p_lim, y_lim=y_lim,
@@ -699,6 +709,7 @@ def _dataset(case, dyn: DynamicModel, stiffness_map: StiffnessMap, which: str,
         "contact_ratio_formula": sim.contact_ratio_formula,
         "hht_alpha": float(sim.hht_alpha if sim.integrator == "hht" else 0.0),
         "stiffness_evaluation": sim.stiffness_evaluation,
+        "stiffness_window": sim.stiffness_window,
         "tolerance": float(sim.tolerance), "tolerance_units": "m",
         "rtol": float(sim.rtol), "max_iterations": int(sim.max_iterations),
         "target_speed": float(dyn.speed), "target_speed_units": "rad/s",
