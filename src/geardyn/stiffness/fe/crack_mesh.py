@@ -37,7 +37,7 @@ from .mesh import _GMSH_LOCK
 from .solve import ElasticMaterial
 
 __all__ = ["CrackedMesh", "mesh_cracked_polygon", "split_crack", "edge_crack_strip",
-           "centre_crack_plate", "solve_tractions", "PlaneSolution"]
+           "centre_crack_plate", "solve_plane", "solve_tractions", "PlaneSolution"]
 
 
 @dataclass(frozen=True)
@@ -98,8 +98,9 @@ def _check_polyline(crack: np.ndarray) -> np.ndarray:
 
 def mesh_cracked_polygon(outline: np.ndarray, crack: np.ndarray, *, tip_size: float,
                          size: float, growth: float = 1.2, edge_crack: bool = True,
-                         names: dict[str, int] | None = None,
-                         crack_size: float | None = None) -> CrackedMesh:
+                         names: dict[str, int | list[int]] | None = None,
+                         crack_size: float | None = None,
+                         refine: list[tuple[np.ndarray, float]] | None = None) -> CrackedMesh:
     """Mesh a polygon with an embedded crack polyline, then split the crack (gmsh, 2-D).
 
     Parameters
@@ -119,12 +120,14 @@ def mesh_cracked_polygon(outline: np.ndarray, crack: np.ndarray, *, tip_size: fl
     edge_crack : bool
         ``True``: ``crack[0]`` is on the boundary (one tip, ``crack[-1]``); ``False``: both
         ends are tips.
-    names : dict of str -> int, optional
-        Boundary segment names: ``name -> i`` for the polygon side from vertex ``i`` to
-        ``i + 1``; returned in :attr:`CrackedMesh.edges`.
+    names : dict of str -> int or list of int, optional
+        Boundary segment names: ``name -> i`` (or a list of such ``i``) for the polygon side(s)
+        from vertex ``i`` to ``i + 1``; returned in :attr:`CrackedMesh.edges`.
     crack_size : float, optional
         Element size along the crack faces away from the tip [m] (default ``4 tip_size``,
         at most ``size``).
+    refine : list of (point, size), optional
+        Extra graded refinement: element ``size`` [m] within ``2 size`` of ``point`` [m].
 
     Returns
     -------
@@ -196,8 +199,23 @@ def mesh_cracked_polygon(outline: np.ndarray, crack: np.ndarray, *, tip_size: fl
             fld.setNumber(t2, "SizeMax", size)
             fld.setNumber(t2, "DistMin", 0.0)
             fld.setNumber(t2, "DistMax", (size - hc) / (growth - 1) + hc)
+            extra = []
+            for q, hq in refine or ():
+                if not (math.isfinite(hq) and 0 < hq <= size):
+                    raise InputError("refine", hq, f"an element size in (0, {size:g}] m")
+                pq = geo.addPoint(float(q[0]), float(q[1]), 0.0, size)
+                geo.synchronize()
+                fq = fld.add("Distance")
+                fld.setNumbers(fq, "PointsList", [pq])
+                tq = fld.add("Threshold")
+                fld.setNumber(tq, "InField", fq)
+                fld.setNumber(tq, "SizeMin", hq)
+                fld.setNumber(tq, "SizeMax", size)
+                fld.setNumber(tq, "DistMin", 2 * hq)
+                fld.setNumber(tq, "DistMax", 2 * hq + (size - hq) / (growth - 1))
+                extra.append(tq)
             fmin = fld.add("Min")
-            fld.setNumbers(fmin, "FieldsList", [t1, t2])
+            fld.setNumbers(fmin, "FieldsList", [t1, t2, *extra])
             fld.setAsBackgroundMesh(fmin)
             gmsh.model.mesh.generate(2)
 
@@ -222,7 +240,8 @@ def mesh_cracked_polygon(outline: np.ndarray, crack: np.ndarray, *, tip_size: fl
                 return np.hstack(out) if out else np.zeros((2, 0), np.int64)
 
             crack_edges = segs_of(clines)
-            edges = {name: segs_of([lines[i]]) for name, i in (names or {}).items()}
+            edges = {name: segs_of([lines[k] for k in np.atleast_1d(i).tolist()])
+                     for name, i in (names or {}).items()}
             tip_nodes = []
             for q in tip_pts:
                 k = int(np.argmin(np.hypot(*(p - q[:, None]))))
@@ -266,6 +285,14 @@ def _left_of(polyline: np.ndarray, pts: np.ndarray) -> np.ndarray:
     dk = d[k]
     rk = pts - a[k]
     return dk[:, 0] * rk[:, 1] - dk[:, 1] * rk[:, 0]
+
+
+def _find(parent: dict[int, int], x: int) -> int:
+    """Root of ``x`` in a union-find forest (with path halving)."""
+    while parent[x] != x:
+        parent[x] = parent[parent[x]]
+        x = parent[x]
+    return x
 
 
 def split_crack(p: np.ndarray, t: np.ndarray, crack_edges: np.ndarray, tips,
@@ -320,19 +347,12 @@ def split_crack(p: np.ndarray, t: np.ndarray, crack_edges: np.ndarray, tips,
                     continue
                 others.setdefault(w, []).append(ti)
         parent = {ti: ti for ti in tris.tolist()}
-
-        def find(x):
-            while parent[x] != x:
-                parent[x] = parent[parent[x]]
-                x = parent[x]
-            return x
-
         for group in others.values():
             for a, b in zip(group[:-1], group[1:], strict=True):
-                parent[find(a)] = find(b)
+                parent[_find(parent, a)] = _find(parent, b)
         comps: dict[int, list[int]] = {}
         for ti in tris.tolist():
-            comps.setdefault(find(ti), []).append(ti)
+            comps.setdefault(_find(parent, ti), []).append(ti)
         if len(comps) != 2:
             raise NumericalError(f"crack node {v} at {p[:, v].tolist()} does not split the mesh "
                                  f"into two faces ({len(comps)} groups of triangles)")
@@ -380,15 +400,16 @@ def edge_crack_strip(width: float, a: float, *, half_height: float | None = None
 def centre_crack_plate(half_width: float, a: float, beta: float, *, tip_size: float,
                        size: float | None = None, growth: float = 1.2) -> CrackedMesh:
     """Square plate ``|x|, |y| <= half_width`` with a centre crack of half-length ``a`` at angle
-    ``beta`` [rad] to the ``y`` axis (the loading axis): ``beta = pi/2`` is a crack normal to
-    the load (pure mode I). Edges ``"top"`` and ``"bottom"``. The crack runs from
-    ``-a (sin beta, cos beta)`` to ``+a (sin beta, cos beta)``; the second end is ``tips[1]``.
+    ``beta`` [rad] to the ``x`` axis: under tension along ``y`` (edges ``"top"`` and
+    ``"bottom"``), ``beta = 0`` is pure mode I. The crack runs from ``-a (cos beta, sin beta)``
+    to ``+a (cos beta, sin beta)``; the second end is ``tips[1]`` (``tip=-1`` in
+    :func:`~.sif.stress_intensity`).
     """
     if not 0 < a < 0.5 * half_width:
         raise InputError("a", a, f"a half-length in (0, {0.5 * half_width:g}) m")
     w = half_width
     size = w / 6 if size is None else size
-    d = np.array([math.sin(beta), math.cos(beta)])
+    d = np.array([math.cos(beta), math.sin(beta)])
     outline = np.array([[-w, -w], [w, -w], [w, w], [-w, w]])
     return mesh_cracked_polygon(outline, np.array([-a * d, a * d]), tip_size=tip_size,
                                 size=size, growth=growth, edge_crack=False,
@@ -419,27 +440,46 @@ class PlaneSolution:
         return self.u[self.basis.nodal_dofs]
 
 
-def solve_tractions(mesh: CrackedMesh, material: ElasticMaterial,
-                    tractions: dict[str, tuple[float, float]]) -> PlaneSolution:
-    """Solve plane elasticity under uniform tractions on named edges (self-equilibrated).
+def _facets_of(m, seg: np.ndarray, name: str) -> np.ndarray:
+    n = m.p.shape[1]
+    fkeys = np.minimum(m.facets[0], m.facets[1]).astype(np.int64) * n + np.maximum(*m.facets)
+    order = np.argsort(fkeys)
+    keys = np.minimum(seg[0], seg[1]).astype(np.int64) * n + np.maximum(seg[0], seg[1])
+    pos = np.searchsorted(fkeys[order], keys)
+    fac = order[np.clip(pos, 0, order.size - 1)]
+    if np.any(fkeys[fac] != keys):
+        raise NumericalError(f"edge {name!r} not found among the mesh facets")
+    return fac
+
+
+def solve_plane(mesh: CrackedMesh, material: ElasticMaterial, *,
+                tractions: dict[str, tuple[float, float]] | None = None,
+                masks: dict[str, np.ndarray] | None = None, fixed: tuple[str, ...] = (),
+                pin: bool = False) -> PlaneSolution:
+    """Solve plane elasticity (P2) on a :class:`CrackedMesh`.
 
     Parameters
     ----------
     mesh : CrackedMesh
     material : ElasticMaterial
-    tractions : dict of str -> (tx, ty)
-        Uniform traction vector [Pa] on each named edge. The loads must balance; the rigid-body
-        motion is removed by pinning the node nearest the lower-left corner (both components)
-        and the node nearest the lower-right corner (``y`` component), which carry no reaction
-        when the loads balance.
+    tractions : dict of str -> (tx, ty), optional
+        Uniform traction [Pa] on the named edges.
+    masks : dict of str -> ndarray of bool, optional
+        Load only the segments of a named edge where the mask (one entry per segment of
+        ``mesh.edges[name]``) is true.
+    fixed : tuple of str
+        Named edges clamped (both components, every DOF on them).
+    pin : bool
+        Remove the rigid-body motion by pinning the node nearest the lower-left corner (both
+        components) and the node nearest the lower-right corner (``y``) instead; the loads must
+        then balance (the pins carry no reaction).
 
     Returns
     -------
     PlaneSolution
     """
     from scipy.sparse.linalg import spsolve
-    from skfem import (Basis, ElementTriP2, ElementVector, FacetBasis, LinearForm, MeshTri,
-                       asm, condense)
+    from skfem import Basis, ElementTriP2, ElementVector, FacetBasis, LinearForm, MeshTri, asm, condense
     from skfem.models.elasticity import linear_elasticity
 
     m = MeshTri(np.ascontiguousarray(mesh.p, float), np.ascontiguousarray(mesh.t))
@@ -448,30 +488,56 @@ def solve_tractions(mesh: CrackedMesh, material: ElasticMaterial,
     lam, mu = material.lame
     K = asm(linear_elasticity(lam, mu), basis).tocsr()
     f = np.zeros(basis.N)
-    n = m.p.shape[1]
-    fkeys = np.minimum(m.facets[0], m.facets[1]).astype(np.int64) * n + np.maximum(*m.facets)
-    order = np.argsort(fkeys)
-    for name, (tx, ty) in tractions.items():
+    for name, spec in (tractions or {}).items():
+        if name not in mesh.edges:
+            raise InputError("tractions", name, f"a named edge: {sorted(mesh.edges)}")
         seg = mesh.edges[name]
-        keys = np.minimum(seg[0], seg[1]).astype(np.int64) * n + np.maximum(seg[0], seg[1])
-        pos = np.searchsorted(fkeys[order], keys)
-        fac = order[np.clip(pos, 0, order.size - 1)]
-        if np.any(fkeys[fac] != keys):
-            raise NumericalError(f"edge {name!r} not found among the mesh facets")
-        fb = FacetBasis(m, e, facets=fac, intorder=4)
+        if name in (masks or {}):
+            seg = seg[:, np.asarray(masks[name], bool)]
+        tx, ty = spec
+        fb = FacetBasis(m, e, facets=_facets_of(m, seg, name), intorder=4)
 
         @LinearForm
         def load(v, w, tx=tx, ty=ty):
             return tx * v[0] + ty * v[1]
 
         f += asm(load, fb)
-    lo = np.array([mesh.p[0].min(), mesh.p[1].min()])
-    hi = np.array([mesh.p[0].max(), mesh.p[1].min()])
-    k0 = int(np.argmin(np.hypot(*(mesh.p - lo[:, None]))))
-    k1 = int(np.argmin(np.hypot(*(mesh.p - hi[:, None]))))
-    nd = basis.nodal_dofs
-    fixed = np.array([nd[0, k0], nd[1, k0], nd[1, k1]])
+    dofs = []
+    for name in fixed:
+        if name not in mesh.edges:
+            raise InputError("fixed", name, f"a named edge: {sorted(mesh.edges)}")
+        dofs.append(basis.get_dofs(facets=_facets_of(m, mesh.edges[name], name)).all())
+    if pin:
+        lo = np.array([mesh.p[0].min(), mesh.p[1].min()])
+        hi = np.array([mesh.p[0].max(), mesh.p[1].min()])
+        k0 = int(np.argmin(np.hypot(*(mesh.p - lo[:, None]))))
+        k1 = int(np.argmin(np.hypot(*(mesh.p - hi[:, None]))))
+        nd = basis.nodal_dofs
+        dofs.append(np.array([nd[0, k0], nd[1, k0], nd[1, k1]]))
+    if not dofs:
+        raise InputError("fixed", fixed, "at least one clamped edge, or pin=True")
+    D = np.unique(np.concatenate(dofs))
     u = np.zeros(basis.N)
-    A, b, x, I = condense(K, f, D=fixed)
+    A, b, _, I = condense(K, f, D=D)
     u[I] = spsolve(A.tocsc(), b)
     return PlaneSolution(mesh=mesh, material=material, basis=basis, u=u)
+
+
+def solve_tractions(mesh: CrackedMesh, material: ElasticMaterial,
+                    tractions: dict[str, tuple[float, float]]) -> PlaneSolution:
+    """Solve plane elasticity under self-equilibrated uniform tractions on named edges
+    (:func:`solve_plane` with ``pin=True``).
+
+    Parameters
+    ----------
+    mesh : CrackedMesh
+    material : ElasticMaterial
+    tractions : dict of str -> (tx, ty)
+        Uniform traction vector [Pa] on each named edge. The loads must balance; the rigid-body
+        motion is removed by three pinned DOFs that then carry no reaction.
+
+    Returns
+    -------
+    PlaneSolution
+    """
+    return solve_plane(mesh, material, tractions=tractions, pin=True)
