@@ -61,7 +61,7 @@ def check_case(case) -> None:
         except GeometryError as exc:
             raise _relabel(exc, field) from None
 
-    crack = case.crack if (case.crack is not None and case.crack.enabled) else None
+    crack = case.crack if (case.crack is not None and case.crack.active) else None
     if crack is not None:
         z = pair.pinion.teeth if crack.gear == "pinion" else pair.gear.teeth
         if crack.tooth >= z:

@@ -256,10 +256,17 @@ class CrackConfig(_Model):
     tooth: int = Field(0, ge=0, strict=True, description="Cracked tooth number (0-based, in "
                                                          "mesh order; tooth k passes the pitch "
                                                          "point at pinion angle 2 pi k / z1).")
-    depth: Length = Field(gt=0, description="Crack length from the root fillet [m].")
+    depth: Length = Field(ge=0, description="Crack length from the root fillet [m]; 0 is the "
+                                            "healthy tooth (a crack of zero size).")
     angle: Angle = Field(math.radians(45), gt=0, lt=math.pi / 2,
                          description="Angle between the crack and the tooth centreline [rad]; the "
                                      "tip is depth*sin(angle) nearer the centreline than the mouth.")
+    @property
+    def active(self) -> bool:
+        """Whether the crack changes the stiffness: enabled and of non-zero depth (a zero-size
+        crack is the healthy tooth, issue 15 item 5, so a sweep over depth can start at 0)."""
+        return bool(self.enabled) and self.depth > 0.0
+
     limit_line: Literal["tip", "parallel"] = Field(
         "tip", description="PEM crack limit line: towards the tooth tip (Mohammed et al. 2013) or "
                            "parallel to the centreline (Chen & Shao 2011).")

@@ -204,7 +204,8 @@ def test_relative_base_case_and_shipped_example(tmp_path):
     assert load_sweep(f).base_case.motor.torque == 77.0
     ex = load_sweep("crack_torque_bearing")  # the shipped example, by name
     p = ex.plan()
-    assert p.grid_shape == (6, 3, 3) and p.n_runs == 54
+    assert p.grid_shape == (7, 3, 3) and p.n_runs == 63
+    assert p.values["crack.depth"].min() == 0.0  # the healthy tooth is the first depth
     assert [q.key for q in p.parameters] == ["crack.depth", "motor.torque",
                                             "pinion.bearing_stiffness", "gear.bearing_stiffness"]
     np.testing.assert_allclose(np.unique(p.values["pinion.bearing_stiffness"]),

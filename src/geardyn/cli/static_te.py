@@ -75,7 +75,7 @@ def static_te(
     if not (tq >= 0 and tq < float("inf")):
         raise InputError("--torque", torque, "a finite pinion torque >= 0 [N m]")
     dd = to_si(centre_distance_change, "length", "--centre-distance-change")
-    has_crack = case.crack is not None and case.crack.enabled
+    has_crack = case.crack is not None and case.crack.active
     if crack and not has_crack:
         raise InputError("--crack", "the case has no enabled crack", "--no-crack, or a case "
                          "with an enabled [crack]")

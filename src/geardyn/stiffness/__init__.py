@@ -42,7 +42,7 @@ def map_inputs(case, method: str, cracked: bool) -> dict:
                  ("centre_distance_min", "centre_distance_max", "centre_distances",
                   "nodes_per_segment")},
         "crack": case.crack.model_dump(mode="json") if (cracked and case.crack is not None
-                                                        and case.crack.enabled) else None,
+                                                        and case.crack.active) else None,
     }
     if cracked and getattr(case, "faults", None):  # only then: earlier keys stay valid
         data["faults"] = [f.model_dump(mode="json") for f in case.faults]

@@ -123,8 +123,8 @@ def stiffness_stage(case: Case, out: Path, result: StudyResult) -> None:
         from ..stiffness.fe import plot_mesh
 
         result.figures["fig_fe_mesh"] = plot_mesh(case, cracked=case.crack is not None
-                                                  and case.crack.enabled)
-    if case.crack is not None and case.crack.enabled:
+                                                  and case.crack.active)
+    if case.crack is not None and case.crack.active:
         result.figures["fig6_crack"] = fig_crack(healthy, cracked)
         dd_op = result.summary.get("static", {}).get("centre_distance_change_mm", 0.0) * 1e-3
         dd_op = dd_op if cracked.covers(dd_op) else 0.0
@@ -174,7 +174,7 @@ def _crack_angle(case: Case, result: StudyResult) -> float | None:
     """Pinion angle [rad] where the crack lowers the stiffness most (from the maps)."""
     from ..stiffness.plots import crack_angle
 
-    if case.crack is None or not case.crack.enabled or "cracked" not in result.maps:
+    if case.crack is None or not case.crack.active or "cracked" not in result.maps:
         return None
     return crack_angle(result.maps["healthy"], result.maps["cracked"], 0.0)
 

@@ -82,7 +82,7 @@ def fe_map(case, dd: np.ndarray, *, cracked: bool,
         crack is on the gear.
     """
     dd = np.atleast_1d(np.asarray(dd, float))
-    n_bodies = 3 if (cracked and case.crack is not None and case.crack.enabled) else 2
+    n_bodies = 3 if (cracked and case.crack is not None and case.crack.active) else 2
     total = n_bodies + dd.size
 
     def p_bodies(i: int, _n: int) -> None:

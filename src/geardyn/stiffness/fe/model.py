@@ -166,7 +166,7 @@ def body_influence(gear: Gear, material: ElasticMaterial, settings: FESettings,
 
 def _crack_of(case, cracked: bool) -> CrackGeometry | None:
     c = case.crack
-    if not cracked or c is None or not c.enabled:
+    if not cracked or c is None or not c.active:
         return None
     return CrackGeometry(depth=float(c.depth), angle=float(c.angle))
 

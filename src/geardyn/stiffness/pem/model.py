@@ -102,7 +102,7 @@ class PEMModel:
     def from_case(cls, case, *, cracked: bool = True, model: str = "exact") -> PEMModel:
         """The model of a :class:`geardyn.config.Case` (its crack if ``cracked`` and enabled)."""
         crack = None
-        if cracked and case.crack is not None and case.crack.enabled:
+        if cracked and case.crack is not None and case.crack.active:
             crack = ToothCrack.from_config(case.crack)
         return cls(case.gear_pair(), case.material.youngs_modulus, case.material.poisson_ratio,
                    crack, model=model, face_width=case.pair.face_width,
