@@ -209,8 +209,14 @@ class ElasticBody:
             self.t_factor = time.perf_counter() - t0
         return self._lu
 
-    def solve(self, rhs: np.ndarray, block: int = 64) -> np.ndarray:
-        """Displacements [m] for loads ``rhs`` (n_dofs, n) [N/m per unit width], bore fixed."""
+    def solve(self, rhs: np.ndarray, block: int = 4) -> np.ndarray:
+        """Displacements [m] for loads ``rhs`` (n_dofs, n) [N/m per unit width], bore fixed.
+
+        The right-hand sides go to SuperLU ``block`` at a time: its multi-column solve slows
+        down per column as the block grows (measured on the paper pinion at refinement 0.5,
+        53,144 DOFs, 48 columns: 4.0 s in one call, 0.95 s one at a time, 0.70 s four at a
+        time, 1.3 s eight at a time); results agree to 2e-15 relative whatever the block.
+        """
         lu = self.factor()
         rhs = np.asarray(rhs, float)
         one = rhs.ndim == 1
