@@ -105,10 +105,18 @@ def stiffness_stage(case: Case, out: Path, result: StudyResult) -> None:
     from ..stiffness import build_map
     from ..stiffness.plots import crack_angle, fig_crack, fig_load_sharing, fig_stiffness
 
+    map_case = _map_case(case, result.quick)
+    if map_case is not case:
+        result.notes.append("--quick: the stiffness maps are coarser than the case's (FE mesh "
+                            f"refinement {map_case.stiffness.fe.refinement:g}, "
+                            f"{map_case.stiffness.centre_distances} centre distances); "
+                            "run without --quick for the case's own maps.")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the maps record their warnings in attrs (read below)
-        healthy = _build_map_with_progress(build_map, case, False, result, "stiffness (healthy)")
-        cracked = _build_map_with_progress(build_map, case, True, result, "stiffness (cracked)")
+        healthy = _build_map_with_progress(build_map, map_case, False, result,
+                                           "stiffness (healthy)")
+        cracked = _build_map_with_progress(build_map, map_case, True, result,
+                                           "stiffness (cracked)")
     for m in (healthy, cracked):
         w = m.attrs.get("warnings", "[]")
         for text in (json.loads(w) if isinstance(w, str) else list(w)):
@@ -139,6 +147,25 @@ def stiffness_stage(case: Case, out: Path, result: StudyResult) -> None:
 
 #: Bump when the simulation or its inputs change meaning, so cached records are recomputed.
 SIMULATION_CACHE_VERSION = "1"
+
+
+#: ``--quick`` maps: FE mesh refinement and centre distances at most these (measured on the paper
+#: case: mean stiffness within 0.1 % of the default maps at +1 mm, built in a third of the time).
+QUICK_REFINEMENT = 0.5
+QUICK_CENTRE_DISTANCES = 11
+
+
+def _map_case(case: Case, quick: bool) -> Case:
+    """The case the stiffness maps are built from (coarser with ``--quick``)."""
+    if not quick:
+        return case
+    st = case.stiffness
+    ov = {}
+    if st.method == "fe" and st.fe.refinement > QUICK_REFINEMENT:
+        ov["stiffness.fe.refinement"] = QUICK_REFINEMENT
+    if st.centre_distances > QUICK_CENTRE_DISTANCES:
+        ov["stiffness.centre_distances"] = QUICK_CENTRE_DISTANCES
+    return case.with_overrides(ov) if ov else case
 
 
 def _simulation_case(case: Case, quick: bool) -> Case:
