@@ -3,8 +3,7 @@
 from __future__ import annotations
 
 import geardyn
-from geardyn.studies.paper import (QUICK_CENTRE_DISTANCES, QUICK_REFINEMENT, _map_case,
-                                   _simulation_case)
+from geardyn.studies.paper import QUICK_CENTRE_DISTANCES, QUICK_REFINEMENT, _map_case, _simulation_case
 
 
 def test_quick_coarsens_the_maps_and_shortens_the_records_only_with_quick():
