@@ -475,6 +475,8 @@ def diagnostics_stage(case: Case, out: Path, result: StudyResult) -> None:
     for i, key in enumerate(keys):
         result.emit(f"diagnostics: model {key[0]}, {key[1]}", i, len(keys))
         diags[key] = _diagnose_run(case, result.sims[key])
+        if key not in (("I", "cracked"), ("II", "cracked")):  # only these are drawn as PWVDs
+            diags[key] = _without_distributions(diags[key])
         result.emit(f"diagnostics: model {key[0]}, {key[1]}", i + 1, len(keys))
     result.diagnoses = diags
     cracked = {m: diags[(m, "cracked")] for m in ("I", "II")}
@@ -528,6 +530,22 @@ def diagnostics_stage(case: Case, out: Path, result: StudyResult) -> None:
         F[f"fig{a}_pwvd_residual_{sig}"] = pf.fig_pwvd_pair(cracked, sig, "residual", z, max_order)
         F[f"fig{b}_demodulation_{sig}"] = pf.fig_demodulation_pair(cracked, sig)
         F[f"fig{c}_analytic_{sig}"] = pf.fig_analytic_pair(cracked, sig)
+    # the figures are rendered: drop the time-frequency distributions (tens of MB per signal and
+    # run), which no later stage reads
+    result.diagnoses = {k: _without_distributions(d) for k, d in diags.items()}
+
+
+def _without_distributions(diag):
+    """``diag`` with each signal's PWVD distributions emptied (angles and orders kept)."""
+    import dataclasses
+
+    def empty(p):
+        return dataclasses.replace(p, distribution=np.zeros((0, 0)))
+
+    return dataclasses.replace(diag, signals={
+        name: dataclasses.replace(sd, pwvd_tsa=empty(sd.pwvd_tsa),
+                                  pwvd_residual=empty(sd.pwvd_residual))
+        for name, sd in diag.signals.items()})
 
 
 def measurement_stage(case: Case, out: Path, result: StudyResult) -> None:
