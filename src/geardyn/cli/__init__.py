@@ -57,7 +57,8 @@ def _optional(name: str) -> None:
             raise
 
 
-for _name in ("stiffness", "simulate", "diagnose", "sweep", "measure", "static_te"):
+for _name in ("stiffness", "simulate", "diagnose", "sweep", "measure", "static_te",
+              "crack_growth"):
     _optional(_name)
 
 

@@ -27,6 +27,12 @@ Model (plane, LEFM, quasi-static, one load position)
 * Indicator: the tooth's compliance at the load point per unit face width,
   ``c = mean(u . n) / load`` over the patch [m^2/N], for each crack length.
 
+From a case: :func:`grow_case_crack` takes the gear, material, initial crack (:func:`case_crack`:
+the ``[crack]`` section or one through-face ``root_crack`` entry) and tooth load
+(:func:`tooth_load`, ``motor.torque``) from a :class:`geardyn.config.Case` and returns the path as
+an xarray Dataset with units (:func:`growth_dataset`); the vibration indicators against cycles
+are a study on top of it (:mod:`geardyn.studies.crack_growth`).
+
 Published path (qualitative comparison). Lewicki & Ballarini (NASA TM-107229 / ARL-TR-1110,
 1996; the ASME J. Mech. Des. 1997 paper), read as its abstract only: "gears with backup ratios
 of 3.3 and 1.0 produced tooth fractures while a backup ratio of 0.3 produced rim fractures"
@@ -52,7 +58,9 @@ from ..stiffness.fe.sif import interaction_integral
 from ..stiffness.fe.solve import ElasticMaterial, flank_points
 from .growth import equivalent_k, mts_angle, paris_cycles
 
-__all__ = ["ToothCrackPath", "grow_tooth_crack", "tooth_sector_outline", "hpstc_roll"]
+__all__ = ["ToothCrackPath", "grow_tooth_crack", "tooth_sector_outline", "hpstc_roll",
+           "CaseCrack", "case_crack", "tooth_load", "equivalent_crack", "grow_case_crack",
+           "growth_dataset"]
 
 
 @dataclass(frozen=True)
@@ -94,12 +102,20 @@ class ToothCrackPath:
     attrs: dict = field(default_factory=dict)
 
 
-def hpstc_roll(pair, centre_distance_change: float = 0.0) -> float:
-    """Pinion roll length of the highest point of single tooth contact [m]:
-    ``u = s_start + p_b`` (the pinion's tooth carries the load alone from ``s_end - p_b`` to
-    ``s_start + p_b`` along the line of action, ``s`` from the pinion's tangency point)."""
+def hpstc_roll(pair, centre_distance_change: float = 0.0, gear: str = "pinion") -> float:
+    """Roll length of the highest point of single tooth contact on ``gear``'s flank [m].
+
+    A tooth carries the load alone while ``s`` (along the line of action from the pinion's
+    tangency point) runs from ``s_end - p_b`` to ``s_start + p_b``. On the pinion the highest
+    point is ``u = s_start + p_b``; on the gear (roll length from the gear's tangency point,
+    ``u = T1T2 - s``) it is ``u = T1T2 - (s_end - p_b)``.
+    """
     op = pair.operating(centre_distance_change)
-    return float(op.s_start + op.base_pitch)
+    if gear == "pinion":
+        return float(op.s_start + op.base_pitch)
+    if gear == "gear":
+        return float(op.t1t2 - (op.s_end - op.base_pitch))
+    raise InputError("gear", gear, "'pinion' or 'gear'")
 
 
 def _insert(poly: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, int]:
@@ -207,6 +223,15 @@ def _inside(outline: np.ndarray, q: np.ndarray) -> bool:
     return bool(Path(outline).contains_point(q))
 
 
+def check_step(step: float, depth: float, field: str = "step") -> None:
+    """Refuse a growth step outside ``(0, 4 depth)`` [m] (``depth`` the initial crack length): a
+    first step four times the crack would jump past the region the initial crack's ``K``
+    describes."""
+    if not (math.isfinite(step) and 0 < step < depth * 4):
+        raise InputError(field, step, f"a crack extension in (0, {4 * depth:g}) m (below four "
+                                      "times the initial crack length)")
+
+
 def grow_tooth_crack(gear: Gear, material: ElasticMaterial, crack: CrackGeometry, *,
                      load: float, load_roll: float, step: float, n_steps: int,
                      patch: float | None = None, teeth: int = 3, n_points: int = 40,
@@ -251,8 +276,7 @@ def grow_tooth_crack(gear: Gear, material: ElasticMaterial, crack: CrackGeometry
     """
     if not (math.isfinite(load) and load > 0):
         raise InputError("load", load, "a force per unit face width > 0 [N/m]")
-    if not (math.isfinite(step) and 0 < step < crack.depth * 4):
-        raise InputError("step", step, f"a crack extension in (0, {4 * crack.depth:g}) m")
+    check_step(step, crack.depth)
     if n_steps < 0:
         raise InputError("n_steps", n_steps, "an integer >= 0")
     rbase = gear.base_radius
@@ -336,3 +360,268 @@ def grow_tooth_crack(gear: Gear, material: ElasticMaterial, crack: CrackGeometry
     return ToothCrackPath(points=np.array(path[:n + 1]), length=arr["length"], K_I=arr["K_I"],
                           K_II=arr["K_II"], theta_c=arr["theta"], K_eq=arr["K_eq"],
                           compliance=arr["compliance"], cycles=cycles, stop=stop, attrs=attrs)
+
+
+# ---------------------------------------------------------------------------- from a case
+@dataclass(frozen=True)
+class CaseCrack:
+    """The initial crack a case gives: its ``[crack]`` section or one ``root_crack`` entry of its
+    ``faults`` list.
+
+    Attributes
+    ----------
+    gear : {"pinion", "gear"}
+        Which gear is cracked.
+    tooth : int
+        Cracked tooth (0-based, mesh order).
+    depth : float
+        Crack length from the mouth [m].
+    angle : float
+        Angle to the tooth centreline [rad].
+    field : str
+        Its name in messages: ``"crack"`` or ``"faults[i]"``.
+    key : str
+        Its dotted key for case overrides: ``"crack"`` or ``"faults.i"``.
+    """
+
+    gear: str
+    tooth: int
+    depth: float
+    angle: float
+    field: str
+    key: str
+
+
+def case_crack(case) -> CaseCrack:
+    """The case's initial crack (see :class:`CaseCrack`).
+
+    Raises
+    ------
+    InputError
+        No crack (an enabled ``[crack]`` or a ``root_crack`` entry), more than one, a crack of
+        zero length, or a ``root_crack`` entry across part of the face only (the growth model is
+        plane: a crack through the whole face width with a uniform front).
+    """
+    found: list[CaseCrack] = []
+    c = getattr(case, "crack", None)
+    if c is not None and c.enabled:
+        found.append(CaseCrack(c.gear, int(c.tooth), float(c.depth), float(c.angle), "crack",
+                               "crack"))
+    L = case.pair.face_width
+    for i, f in enumerate(getattr(case, "faults", None) or ()):
+        if f.type != "root_crack":
+            continue
+        field = f"faults[{i}]"
+        if f.width is not None and f.width < L * (1 - 1e-12):
+            raise InputError(f"{field}.width", f.width, f"the whole face width ({L:g} m) or no "
+                             "width: crack growth is modelled in the plane (a through-face crack)")
+        if f.front not in (None, "uniform"):
+            raise InputError(f"{field}.front", f.front, "'uniform' (or none): crack growth is "
+                                                        "modelled in the plane")
+        angle = math.radians(45) if f.angle is None else float(f.angle)
+        found.append(CaseCrack(f.gear, int(f.tooth), float(f.depth or 0.0), angle, field,
+                               f"faults.{i}"))
+    if not found:
+        raise InputError("crack", None, "an initial crack to grow: an enabled [crack] section or "
+                                        "a [[faults]] entry with type = 'root_crack'")
+    if len(found) > 1:
+        raise InputError(found[1].field, "a second root crack", f"one initial crack only "
+                         f"({found[0].field} is one; disable or remove the other)")
+    crack = found[0]
+    if not crack.depth > 0:
+        raise InputError(f"{crack.field}.depth", crack.depth, "an initial crack length > 0 m "
+                                                              "(growth starts from a crack)")
+    return crack
+
+
+def tooth_load(case) -> float:
+    """Tooth load of the growth model per unit face width [N/m]: the whole mesh force of the
+    pinion torque on one tooth, ``W = T / (r_b1 b)`` (``T = motor.torque`` [N m], ``r_b1`` the
+    pinion's base radius, ``b`` the face width). The same normal force acts on the gear's
+    tooth."""
+    pair = case.gear_pair()
+    return float(case.motor.torque / (pair.pinion.base_radius * case.pair.face_width))
+
+
+def initial_geometry(case):
+    """Validate the case's initial crack on its gear; returns ``(CaseCrack, Gear,
+    CrackGeometry, mouth, tip)`` (mouth and tip [m] in the body frame of tooth 0).
+
+    Raises
+    ------
+    InputError
+        As :func:`case_crack`, or a crack deeper than the tooth (it leaves the tooth section),
+        naming ``crack.depth`` or ``faults[i].depth``.
+    """
+    from .base import gear_of
+
+    c = case_crack(case)
+    gear = gear_of(case.gear_pair(), c.gear)
+    try:
+        geom = CrackGeometry(c.depth, c.angle)
+        mouth, tip = crack_segment(gear, geom)
+    except InputError as exc:
+        key = str(exc.field).rsplit(".", 1)[-1]
+        raise InputError(f"{c.field}.{key}", exc.value, exc.allowed) from None
+    return c, gear, geom, mouth, tip
+
+
+def equivalent_crack(mouth, tip) -> tuple[float, float]:
+    """The straight crack of the chord from the mouth to a tip: ``(depth [m], angle [rad])``.
+
+    In the body frame of :mod:`geardyn.stiffness.fe.mesh` (tooth on ``+y``, loaded flank at
+    ``x < 0``) a straight crack of length ``q`` at angle ``v`` to the centreline runs along
+    ``(sin v, -cos v)``, so the chord ``d = tip - mouth`` gives ``q = |d|`` and
+    ``v = atan2(d_x, -d_y)``. ``v`` outside ``(0, pi/2)`` (a tip above its mouth, or on the
+    loaded side of it) has no straight-crack equivalent in the PEM.
+    """
+    d = np.asarray(tip, float) - np.asarray(mouth, float)
+    return float(np.hypot(*d)), float(math.atan2(d[0], -d[1]))
+
+
+def grow_case_crack(case, *, paris_c: float, paris_m: float, paris_threshold: float = 0.0,
+                    step: float | None = None, n_steps: int = 60, teeth: int = 3,
+                    progress: Callable[[int, int], None] | None = None):
+    """Grow the case's root crack (module docstring) and return the path as a Dataset.
+
+    The gear, its outline and bore come from the case; the material from ``[material]`` with
+    ``stiffness.fe.plane``; the initial crack from :func:`case_crack`; the tooth load from
+    :func:`tooth_load` (``motor.torque``) at the highest point of single tooth contact of the
+    cracked gear (:func:`hpstc_roll`, design centre distance). Paris constants are required:
+    geardyn ships none (:mod:`geardyn.faults.growth`).
+
+    Parameters
+    ----------
+    case : geardyn.config.Case
+    paris_c : float
+        Paris ``C`` [m/cycle/(Pa m^0.5)^m] (:func:`geardyn.faults.growth.paris_c_from_mpa`
+        converts one quoted per MPa m^0.5).
+    paris_m : float
+        Paris exponent ``m`` [-].
+    paris_threshold : float
+        ``Delta K_th`` [Pa m^0.5].
+    step : float, optional
+        Crack extension per step [m] (default ``module / 6``).
+    n_steps : int
+        Largest number of extensions (growth stops earlier when the tip comes within one step
+        of the outline).
+    teeth : int
+        Teeth in the FE sector (odd).
+    progress : callable, optional
+        ``progress(done, total)`` per analysed tip.
+
+    Returns
+    -------
+    xarray.Dataset
+        Over ``crack_length`` [m] (along the path from the mouth): ``tip_x``, ``tip_y`` [m];
+        ``K_I``, ``K_II``, ``K_eq`` [Pa m^0.5]; ``kink_angle`` [rad]; ``cycles`` [-] (from the
+        initial crack, one zero-to-peak load cycle per revolution of the cracked gear);
+        ``compliance`` [m^2/N] (load-point compliance per unit face width). Over
+        ``path_point``: the crack polyline ``path_x``, ``path_y`` [m] (mouth first). Over
+        ``outline_point``: the FE sector's outline ``outline_x``, ``outline_y`` [m]. Inputs,
+        the stop reason and the model's assumptions in the attributes.
+    """
+    from .growth import _check_paris
+
+    _check_paris(float(paris_c), float(paris_m), float(paris_threshold))
+    c, gear, geom, mouth, _ = initial_geometry(case)
+    pair = case.gear_pair()
+    material = ElasticMaterial(case.material.youngs_modulus, case.material.poisson_ratio,
+                               case.stiffness.fe.plane)
+    load = tooth_load(case)
+    roll = hpstc_roll(pair, 0.0, c.gear)
+    step = gear.module / 6 if step is None else float(step)
+    check_step(step, c.depth)
+    if isinstance(n_steps, bool) or int(n_steps) != n_steps or not 0 <= n_steps <= 1000:
+        raise InputError("n_steps", n_steps, "an integer from 0 to 1000")
+    path = grow_tooth_crack(gear, material, geom, load=load, load_roll=roll, step=step,
+                            n_steps=int(n_steps), teeth=teeth,
+                            paris=(float(paris_c), float(paris_m)),
+                            paris_threshold=float(paris_threshold), progress=progress)
+    outline, _ = tooth_sector_outline(gear, mouth, teeth=teeth)
+    ds = growth_dataset(path, outline, case=case, crack=c, gear=gear)
+    ds.attrs["paris_threshold"] = float(paris_threshold)
+    ds.attrs["paris_threshold_units"] = "Pa m^0.5"
+    return ds
+
+
+def growth_dataset(path: ToothCrackPath, outline: np.ndarray, *, case=None,
+                   crack: CaseCrack | None = None, gear: Gear | None = None):
+    """A :class:`ToothCrackPath` as an xarray Dataset with units and long names on every
+    variable (layout in :func:`grow_case_crack`)."""
+    import xarray as xr
+
+    n = path.length.shape[0]
+    cyc = np.full(n, np.nan) if path.cycles is None else np.asarray(path.cycles, float)
+    pts = np.asarray(path.points, float)
+
+    def v(dim, data, units, long):
+        return (dim, np.asarray(data, float), {"units": units, "long_name": long})
+
+    L = "crack_length"
+    ds = xr.Dataset(
+        {
+            "tip_x": v(L, pts[1:n + 1, 0], "m", "crack tip abscissa (body frame: cracked tooth "
+                                                "on +y, loaded flank at x < 0)"),
+            "tip_y": v(L, pts[1:n + 1, 1], "m", "crack tip ordinate (body frame)"),
+            "K_I": v(L, path.K_I, "Pa m^0.5", "mode I stress intensity factor at the tip "
+                                               "(interaction integral) under the tooth load"),
+            "K_II": v(L, path.K_II, "Pa m^0.5", "mode II stress intensity factor at the tip"),
+            "kink_angle": v(L, path.theta_c, "rad", "kink angle of the next extension (maximum "
+                                                    "tangential stress), from the crack "
+                                                    "direction, positive to its left"),
+            "K_eq": v(L, path.K_eq, "Pa m^0.5", "equivalent mode I factor K_theta(theta_c) "
+                                                "(Delta K of the Paris law, R = 0)"),
+            "cycles": v(L, cyc, "1", "load cycles from the initial crack (Paris law, "
+                                     "trapezoidal rule; one zero-to-peak cycle per revolution "
+                                     "of the cracked gear)"),
+            "compliance": v(L, path.compliance, "m^2/N", "load-point compliance of the tooth "
+                                                         "along the line of action, per unit "
+                                                         "face width"),
+            "path_x": v("path_point", pts[:, 0], "m", "crack polyline abscissa, mouth first "
+                                                      "(body frame)"),
+            "path_y": v("path_point", pts[:, 1], "m", "crack polyline ordinate, mouth first"),
+            "outline_x": v("outline_point", outline[:, 0], "m", "FE sector outline abscissa "
+                                                                "(body frame)"),
+            "outline_y": v("outline_point", outline[:, 1], "m", "FE sector outline ordinate"),
+        },
+        coords={L: (L, np.asarray(path.length, float),
+                    {"units": "m", "long_name": "crack length along the path from the mouth"})},
+    )
+    a = path.attrs
+    paris = a.get("paris")
+    attrs = {
+        "title": "geardyn crack growth: path, stress intensity factors, Paris cycles",
+        "stop": path.stop,
+        "tooth_load_N_per_m": a["load"][0],
+        "load_roll_length_m": a["load_roll"][0],
+        "step_m": a["step"][0],
+        "load_patch_half_length_m": a["patch"][0],
+        "initial_depth_m": a["initial_depth"][0],
+        "initial_angle_rad": a["initial_angle"][0],
+        "sector_teeth": int(a["teeth"]),
+        "plane": a["plane"],
+        "youngs_modulus_Pa": float(a["youngs_modulus"][0]),
+        "poisson_ratio": float(a["poisson_ratio"]),
+        "model": "plane LEFM, quasi-static: a sector of the cracked gear clamped at the bore "
+                 "and the radial cuts, the tooth load along the line of action at the highest "
+                 "point of single tooth contact; K by the interaction integral, direction by "
+                 "the maximum tangential stress criterion, remeshed each step "
+                 "(geardyn.faults.tooth_growth)",
+    }
+    if paris is not None:
+        attrs["paris_C"] = float(paris[0])
+        attrs["paris_C_units"] = "m/cycle/(Pa m^0.5)^m"
+        attrs["paris_m"] = float(paris[1])
+    if case is not None:
+        attrs["case"] = case.name
+        attrs["motor_torque_N_m"] = float(case.motor.torque)
+    if crack is not None:
+        attrs["cracked_gear"] = crack.gear
+        attrs["cracked_tooth"] = crack.tooth
+        attrs["initial_crack_from"] = crack.field
+    if gear is not None:
+        attrs["gear_teeth"] = int(gear.teeth)
+        attrs["module_m"] = float(gear.module)
+    ds.attrs.update(attrs)
+    return ds
