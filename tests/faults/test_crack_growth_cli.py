@@ -170,6 +170,12 @@ def test_example_quick_through_the_cli(tmp_path):
     assert list(ds["simulation_status"].values) == ["ok"] * 3
     fm4 = ds["v_yg__FM4"].values
     assert np.all(np.isfinite(fm4)) and np.isfinite(float(ds["v_yg__FM4_healthy"]))
+    # with the default 20 dB of noise the healthy difference signal is noise-like: FM4 of a
+    # Gaussian signal is 3, within about 3 standard errors sqrt(24/2048) of a 2048-sample
+    # estimate; the longest crack stands far above it
+    assert "20 dB" in ds.attrs["indicator_noise"]
+    assert abs(float(ds["v_yg__FM4_healthy"]) - 3.0) < 3 * math.sqrt(24 / 2048) + 0.1
+    assert fm4[-1] > 10
     er = ds["transmission_error__EnergyRatio"].values
     assert np.all(np.isfinite(er)) and er[-1] > er[0]  # a longer crack, a larger energy ratio
     assert np.all(np.diff(ds["sample_cycles"].values) > 0)

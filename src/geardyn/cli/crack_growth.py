@@ -147,6 +147,13 @@ def crack_growth(
     points: Annotated[int | None, typer.Option(
         "--points", help="Crack lengths simulated for the indicators (default 5, --quick 3).",
         show_default=False)] = None,
+    snr: Annotated[float | None, typer.Option(
+        "--snr", help="White noise added to each simulated signal before the TSA, as a "
+                      "signal-to-noise ratio in dB (default 20, as the shipped sweep); "
+                      "--no-noise for none.", show_default=False)] = None,
+    no_noise: Annotated[bool, typer.Option(
+        "--no-noise", help="Indicators of the noise-free signals (a healthy gear's are then "
+                           "numerical residue).")] = False,
     quick: Annotated[bool, typer.Option(
         "--quick", help="A coarse, fast run: module/4 steps, at most 20, 3 simulated lengths, "
                         "0.2 s settle and 0.3 s record.")] = False,
@@ -187,6 +194,9 @@ def crack_growth(
         raise InputError("--steps", steps, "an integer from 0 to 1000")
     if points is not None and not 1 <= points <= 100:
         raise InputError("--points", points, "an integer from 1 to 100")
+    if snr is not None and (no_noise or not math.isfinite(snr)):
+        raise InputError("--snr", snr, "a finite signal-to-noise ratio in dB, without --no-noise")
+    noise_snr_db = None if no_noise else (20.0 if snr is None else float(snr))
     case = load_case_from_cli(config, set_)
 
     from ..faults.tooth_growth import check_step, initial_geometry
@@ -203,7 +213,8 @@ def crack_growth(
     settle = QUICK["settle_time"] if quick else None
     record = QUICK["record_time"] if quick else None
     options = {"paris_c_si": c_si, "paris_m": paris_m, "paris_threshold_si": dk_th,
-               "steps": n_steps, "step_m": step, "points": n_points, "quick": quick}
+               "steps": n_steps, "step_m": step, "points": n_points, "quick": quick,
+               "noise_snr_db": noise_snr_db}
     ident = identity("crack-growth", case, options)
     state = claim_folder(target, ident, force=force, results=RESULTS, record=False)
 
@@ -217,7 +228,9 @@ def crack_growth(
         progress("crack growth", 0, 0)
         ds = crack_growth_study(case, paris_c=c_si, paris_m=paris_m, paris_threshold=dk_th,
                                 step=step, n_steps=n_steps, points=n_points,
-                                settle_time=settle, record_time=record, progress=progress)
+                                settle_time=settle, record_time=record,
+                                noise_snr_db=noise_snr_db,
+                                progress=progress)
         progress.close()
     say_state(state, target)
     begin(target, ident)
