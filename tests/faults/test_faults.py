@@ -209,11 +209,14 @@ def test_overlapping_faults_refused(base):
     base.with_overrides({"faults": [SPALL, {**other, "tooth": 12}]})
 
 
-def test_fe_refuses_the_faults_list(base):
-    c = base.with_overrides({"faults": [SPALL]})
-    with pytest.raises(InputError, match=r"faults\[0\] \(type spall\).*fe method") as exc:
+def test_fe_refuses_what_it_does_not_model(base):
+    """The FE models every fault type (tests/fe/test_fe_faults.py) but not the thinner worn
+    tooth: refused before any body is built, naming the field."""
+    c = base.with_overrides({"faults": [{"type": "wear", "tooth": 11, "depth": "30 um",
+                                         "stiffness": True}]})
+    with pytest.raises(InputError, match="FE method") as exc:
         build_map(c, method="fe")
-    assert exc.value.field == "stiffness.method"
+    assert exc.value.field == "faults[0].stiffness"
 
 
 def test_cache_identity_and_case_text(base, tmp_path):

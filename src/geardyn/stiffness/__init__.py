@@ -68,8 +68,8 @@ def build_map(case, *, method: str | None = None, cracked: bool = True,
         Default: ``case.stiffness.method``.
     cracked : bool
         Include the case's crack (if it has an enabled one) and its ``faults`` list; ``False``
-        gives the healthy map. The FE method refuses a case with a ``faults`` list
-        (:func:`geardyn.faults.check_method`).
+        gives the healthy map. The FE method refuses the faults it does not model, naming the
+        field (:func:`geardyn.faults.check_method`, :mod:`geardyn.stiffness.fe.faults`).
     progress : callable, optional
         ``progress(done, total)``.
     cache : geardyn.cache.Cache, optional

@@ -65,7 +65,8 @@ def fe_map(case, dd: np.ndarray, *, cracked: bool,
     dd : ndarray
         Centre distance changes [m] (uniform, increasing).
     cracked : bool
-        Include the case's crack if it has an enabled one.
+        Include the case's faults: an enabled ``[crack]`` and the ``faults`` list (what the FE
+        does with each fault: :mod:`.faults`).
     progress : callable, optional
         ``progress(done, total)``: the bodies (meshing, factorisation, influence coefficients),
         then each centre distance.
@@ -78,26 +79,26 @@ def fe_map(case, dd: np.ndarray, *, cracked: bool,
         ``k_mb`` [N/m] and extras ``load_share`` (n_d, nodes, 3) [-] for the three load-share
         slots of each cycle, ``load_share_exiting`` [-] (the pair in extended contact beyond the
         theoretical end of the path, which has no slot), ``pairs_in_contact`` [-],
-        ``transmission_error`` [rad]. One pinion revolution, or one gear revolution when the
-        crack is on the gear.
+        ``transmission_error`` [rad]; ``fault_gap`` [m] (n_d, nodes, 3) with a worn tooth.
+        One pinion revolution, or one gear revolution when a gear tooth is faulty (``lcm(z1,
+        z2)`` mesh cycles with faults on both).
     """
     dd = np.atleast_1d(np.asarray(dd, float))
-    n_bodies = 3 if (cracked and case.crack is not None and case.crack.active) else 2
-    total = n_bodies + dd.size
+    n_bodies = [0]
 
-    def p_bodies(i: int, _n: int) -> None:
+    def p_bodies(i: int, n: int) -> None:
+        n_bodies[0] = n
         if progress is not None:
-            progress(i, total)
+            progress(i, n + dd.size)
 
     model = FEStiffness(case, cracked=cracked, cache=cache, progress=p_bodies)
 
     def p_lines(i: int, _n: int) -> None:
         if progress is not None:
-            progress(n_bodies + i, total)
+            progress(n_bodies[0] + i, n_bodies[0] + dd.size)
 
-    n_cycles = None
-    if model.crack is not None and case.crack.gear == "gear":
-        n_cycles = model.pair.gear.teeth  # one gear revolution holds every pair once
+    # one gear revolution (or lcm of the teeth) when a gear tooth is faulty
+    n_cycles = model.period_cycles
     return StiffnessMap.from_function(model.pair, dd, model.evaluate, n_cycles=n_cycles,
                                       n_seg=case.stiffness.nodes_per_segment,
                                       attrs=model.attrs(), progress=p_lines)

@@ -307,8 +307,8 @@ class BodyCompliance:
     Parameters
     ----------
     influence : BodyInfluence
-        Healthy body (loaded on tooth 0 only; cyclic symmetry gives the other teeth) or cracked
-        body (loaded on every refined tooth; model tooth 0 cracked).
+        Healthy body (loaded on tooth 0 only; cyclic symmetry gives the other teeth) or faulty
+        body (loaded on every refined tooth; model tooth 0 faulty: cracked, broken or both).
     teeth : int
         Number of teeth of the gear.
     """
@@ -319,19 +319,28 @@ class BodyCompliance:
         u = influence.u
         self.u_min, self.u_max = float(u[0]), float(u[-1])
         self.cyclic = influence.load_offsets == (0,)
+        ro = influence.read_offsets
+        #: roll-length range of the points of each model tooth [m] (a broken tooth's is shorter)
+        self.bounds = {j: (float(influence.grid(j)[0]), float(influence.grid(j)[-1]))
+                       for j in ro}
         self._self: dict[int, CubicSpline] = {}
         self._cross: dict[tuple[int, int], RectBivariateSpline] = {}
-        ro = influence.read_offsets
         for a, i in enumerate(influence.load_offsets):
             b = ro.index(i)
-            self._self[i] = CubicSpline(u, np.diag(influence.H[a, b]))
+            self._self[i] = CubicSpline(influence.grid(i), np.diag(influence.H[a, b]))
             for b, j in enumerate(ro):
                 if j != i:
-                    self._cross[(i, j)] = RectBivariateSpline(u, u, influence.H[a, b])
+                    self._cross[(i, j)] = RectBivariateSpline(influence.grid(j),
+                                                              influence.grid(i),
+                                                              influence.H[a, b])
 
     def covers(self, offset: int) -> bool:
-        """Whether model tooth ``offset`` is loaded in this body's model (cracked bodies)."""
+        """Whether model tooth ``offset`` is loaded in this body's model (faulty bodies)."""
         return offset in self.inf.load_offsets
+
+    def _clip(self, offset: int, u):
+        lo, hi = self.bounds.get(offset, (self.u_min, self.u_max))
+        return np.clip(u, lo, hi)
 
     def batch(self, load: np.ndarray, u_load: np.ndarray, read: np.ndarray,
               u_read: np.ndarray) -> np.ndarray:
@@ -342,11 +351,11 @@ class BodyCompliance:
         """
         load = np.asarray(load, np.int64)
         read = np.asarray(read, np.int64)
-        ul = np.clip(u_load, self.u_min, self.u_max)
-        ur = np.clip(u_read, self.u_min, self.u_max)
+        u_load = np.asarray(u_load, float)
+        u_read = np.asarray(u_read, float)
         if self.cyclic:
             read, load = read - load, np.zeros_like(load)
-        out = np.zeros(ul.shape)
+        out = np.zeros(u_load.shape)
         if out.size == 0:
             return out
         base = int(max(np.max(np.abs(load)), np.max(np.abs(read)))) + 1
@@ -354,26 +363,29 @@ class BodyCompliance:
         for c in np.unique(code):
             sel = code == c
             i, j = int(c // (2 * base + 1) - base), int(c % (2 * base + 1) - base)
+            ul = self._clip(i, u_load[sel])
             if i == j:
-                out[sel] = self._self[i](ul[sel])
+                out[sel] = self._self[i](ul)
             else:
                 f = self._cross.get((i, j))
                 if f is not None:
-                    out[sel] = f.ev(ur[sel], ul[sel])
+                    out[sel] = f.ev(self._clip(j, u_read[sel]), ul)
         return out
 
     def __call__(self, load: int, u_load: float, read: int, u_read: float) -> float:
         """Compliance [m^2/N]: displacement at ``u_read`` on model tooth ``read`` per unit load at
         ``u_load`` on model tooth ``load`` (0 if the teeth are farther apart than the model)."""
-        ul = min(max(u_load, self.u_min), self.u_max)
-        ur = min(max(u_read, self.u_min), self.u_max)
         if self.cyclic:
             read, load = read - load, 0
+        lo, hi = self.bounds.get(load, (self.u_min, self.u_max))
+        ul = min(max(u_load, lo), hi)
         if read == load:
             return float(self._self[load](ul))
         f = self._cross.get((load, read))
         if f is None:
             return 0.0
+        lo, hi = self.bounds.get(read, (self.u_min, self.u_max))
+        ur = min(max(u_read, lo), hi)
         return float(f(ur, ul)[0, 0])
 
 
@@ -492,26 +504,46 @@ class PairContactModel:
     pair : geardyn.geometry.GearPair
     pinion, gear : BodyCompliance
         Healthy bodies.
+    bodies : dict, optional
+        Faulty bodies: ``(which, tooth) -> BodyCompliance`` whose model tooth 0 is tooth
+        ``tooth`` (mesh order) of ``which`` (``"pinion"`` or ``"gear"``). The coefficient between
+        two teeth both loaded in a faulty body's model comes from that body, any other from the
+        healthy body (so two faulty bodies of one gear must not load a common tooth:
+        :func:`geardyn.stiffness.fe.faults.check_fe_faults`).
     cracked : BodyCompliance, optional
-        The cracked body (model tooth 0 is the cracked tooth).
+        One faulty body (the ``[crack]`` model), the same as ``bodies={(crack_gear,
+        crack_tooth): cracked}``.
     crack_gear : {"pinion", "gear"}
     crack_tooth : int
         Cracked tooth number (mesh order).
-    material_pinion, material_gear : ElasticMaterial-like with ``plane_modulus``
+    plane_modulus : (float, float)
+        Plane moduli of the pinion and the gear [Pa].
     half_width : float
         Reference patch half-width of the influence coefficients [m].
+    marked : iterable of (str, int), optional
+        Teeth with a fault but no faulty body (a spall): positions involving them are not
+        repeated from another mesh cycle (:meth:`fault_rows`).
     """
 
     def __init__(self, pair, pinion: BodyCompliance, gear: BodyCompliance, *,
                  cracked: BodyCompliance | None = None, crack_gear: str = "pinion",
                  crack_tooth: int = 0, plane_modulus: tuple[float, float],
-                 half_width: float, local: bool = True):
+                 half_width: float, local: bool = True, bodies: dict | None = None,
+                 marked=()):
         self.pair = pair
         self.pinion = pinion
         self.gear = gear
-        self.cracked = cracked
-        self.crack_gear = crack_gear
-        self.crack_tooth = int(crack_tooth)
+        bodies = dict(bodies or {})
+        if cracked is not None:
+            bodies[(crack_gear, int(crack_tooth))] = cracked
+        self.bodies: dict[tuple[str, int], BodyCompliance] = {
+            (w, int(t)): b for (w, t), b in bodies.items()}
+        first = next(iter(self.bodies.items()), None)
+        #: the first faulty body, its gear and tooth (``None``, "pinion", 0 without one)
+        self.cracked = None if first is None else first[1]
+        self.crack_gear = "pinion" if first is None else first[0][0]
+        self.crack_tooth = 0 if first is None else first[0][1]
+        self.marked = frozenset((w, int(t)) for w, t in marked)
         self.e1, self.e2 = plane_modulus
         self.half_width = half_width
         self.estar = 1.0 / (1.0 / self.e1 + 1.0 / self.e2)
@@ -522,68 +554,84 @@ class PairContactModel:
     def _wrap(self, d: int, z: int) -> int:
         return int((d + z // 2) % z - z // 2)
 
-    def model_offset(self, which: str, tooth: int) -> int:
-        """Model tooth of a real tooth: relative to the cracked tooth on the cracked gear, else to
-        tooth 0. Pinion teeth follow each other clockwise in the body model (whose offsets run
-        counter-clockwise), gear teeth counter-clockwise."""
-        z = self.pair.pinion.teeth if which == "pinion" else self.pair.gear.teeth
+    def _teeth(self, which: str) -> int:
+        return self.pair.pinion.teeth if which == "pinion" else self.pair.gear.teeth
+
+    def _own(self, which: str) -> list[tuple[int, BodyCompliance]]:
+        return [(t, b) for (w, t), b in self.bodies.items() if w == which]
+
+    def model_offset(self, which: str, tooth: int, ref: int | None = None) -> int:
+        """Model tooth of a real tooth relative to tooth ``ref`` (default: the first faulty
+        tooth of that gear, else tooth 0). Pinion teeth follow each other clockwise in the body
+        model (whose offsets run counter-clockwise), gear teeth counter-clockwise."""
+        z = self._teeth(which)
         sign = -1 if which == "pinion" else 1
-        ref = self.crack_tooth if (self.cracked is not None and which == self.crack_gear) else 0
+        if ref is None:
+            own = self._own(which)
+            ref = own[0][0] if own else 0
         return sign * self._wrap(int(tooth) - ref, z)
 
     def involves_crack(self, cand: Candidates) -> bool:
-        """Whether any candidate tooth is within the cracked body's refined teeth."""
-        if self.cracked is None:
-            return False
-        teeth = cand.pinion_tooth if self.crack_gear == "pinion" else cand.gear_tooth
-        return self.teeth_involve_crack(teeth)
+        """Whether any candidate tooth is loaded in a faulty body's model or marked."""
+        return bool(self.teeth_involve_crack(cand.pinion_tooth, "pinion")
+                    or self.teeth_involve_crack(cand.gear_tooth, "gear"))
 
-    def teeth_involve_crack(self, teeth) -> bool:
-        """Whether any of these teeth of the cracked gear is within the cracked body's refined
-        teeth."""
-        if self.cracked is None:
-            return False
-        return any(self.cracked.covers(self.model_offset(self.crack_gear, int(t)))
-                   for t in teeth)
+    def teeth_involve_crack(self, teeth, which: str | None = None) -> bool:
+        """Whether any of these teeth of ``which`` (default: the first faulty body's gear) is
+        loaded in a faulty body's model or marked."""
+        which = self.crack_gear if which is None else which
+        for t in teeth:
+            if (which, int(t)) in self.marked:
+                return True
+            for ref, body in self._own(which):
+                if body.covers(self.model_offset(which, int(t), ref)):
+                    return True
+        return False
 
     def _side(self, which: str, teeth: np.ndarray, u: np.ndarray) -> np.ndarray:
         n = teeth.size
         out = np.zeros((n, n))
         healthy = self.pinion if which == "pinion" else self.gear
-        cracked = self.cracked if which == self.crack_gear else None
-        m = [self.model_offset(which, int(t)) for t in teeth]
+        own = self._own(which)
+        z = self._teeth(which)
+        m = [self.model_offset(which, int(t), 0) for t in teeth]
         for j in range(n):
             for k in range(n):
-                if cracked is not None and cracked.covers(m[k]) and cracked.covers(m[j]):
-                    out[j, k] = cracked(m[k], u[k], m[j], u[j])
+                for ref, body in own:
+                    mj = self.model_offset(which, int(teeth[j]), ref)
+                    mk = self.model_offset(which, int(teeth[k]), ref)
+                    if body.covers(mk) and body.covers(mj):
+                        out[j, k] = body(mk, u[k], mj, u[j])
+                        break
                 else:
-                    z = self.pair.pinion.teeth if which == "pinion" else self.pair.gear.teeth
                     out[j, k] = healthy(0, u[k], self._wrap(m[j] - m[k], z), u[j])
         # Maxwell-Betti: the patch-to-point coefficients are symmetric up to discretisation
         return 0.5 * (out + out.T)
 
     def _side_batch(self, which: str, teeth: np.ndarray, u: np.ndarray) -> np.ndarray:
-        z = self.pair.pinion.teeth if which == "pinion" else self.pair.gear.teeth
+        z = self._teeth(which)
         sign = -1 if which == "pinion" else 1
-        ref = self.crack_tooth if (self.cracked is not None and which == self.crack_gear) else 0
         healthy = self.pinion if which == "pinion" else self.gear
-        cracked = self.cracked if which == self.crack_gear else None
-        m = sign * ((np.asarray(teeth, np.int64) - ref + z // 2) % z - z // 2)
-        npos, n = m.shape
+        teeth = np.asarray(teeth, np.int64)
+        npos, n = teeth.shape
         shape = (npos, n, n)
-        mk = np.broadcast_to(m[:, None, :], shape)  # load on candidate k (column)
-        mj = np.broadcast_to(m[:, :, None], shape)  # read on candidate j (row)
         uk = np.broadcast_to(u[:, None, :], shape)
         uj = np.broadcast_to(u[:, :, None], shape)
         out = np.zeros(shape)
-        if cracked is not None:
-            cov = np.isin(m, cracked.inf.load_offsets)
-            use = cov[:, None, :] & cov[:, :, None]
-        else:
-            use = np.zeros(shape, bool)
-        if use.any():
-            out[use] = cracked.batch(mk[use], uk[use], mj[use], uj[use])
-        rest = ~use
+        done = np.zeros(shape, bool)
+        for ref, body in self._own(which):
+            m = sign * ((teeth - ref + z // 2) % z - z // 2)
+            mk = np.broadcast_to(m[:, None, :], shape)  # load on candidate k (column)
+            mj = np.broadcast_to(m[:, :, None], shape)  # read on candidate j (row)
+            cov = np.isin(m, body.inf.load_offsets)
+            use = cov[:, None, :] & cov[:, :, None] & ~done
+            if use.any():
+                out[use] = body.batch(mk[use], uk[use], mj[use], uj[use])
+                done |= use
+        m = sign * ((teeth + z // 2) % z - z // 2)
+        mk = np.broadcast_to(m[:, None, :], shape)
+        mj = np.broadcast_to(m[:, :, None], shape)
+        rest = ~done
         rel = (mj[rest] - mk[rest] + z // 2) % z - z // 2
         out[rest] = healthy.batch(np.zeros_like(rel), uk[rest], rel, uj[rest])
         return 0.5 * (out + np.swapaxes(out, 1, 2))
@@ -599,13 +647,18 @@ class PairContactModel:
     def crack_rows(self, pair_index: np.ndarray, valid: np.ndarray) -> np.ndarray:
         """:meth:`involves_crack` of many positions: pair indices ``n`` (positions, k) of which
         ``valid`` entries are candidates -> bool (positions,)."""
-        if self.cracked is None:
-            return np.zeros(pair_index.shape[0], bool)
-        z = self.pair.pinion.teeth if self.crack_gear == "pinion" else self.pair.gear.teeth
-        sign = -1 if self.crack_gear == "pinion" else 1
-        teeth = np.mod(pair_index, z)
-        m = sign * ((teeth - self.crack_tooth + z // 2) % z - z // 2)
-        return np.any(np.isin(m, self.cracked.inf.load_offsets) & valid, axis=1)
+        out = np.zeros(pair_index.shape[0], bool)
+        for which in ("pinion", "gear"):
+            z = self._teeth(which)
+            sign = -1 if which == "pinion" else 1
+            teeth = np.mod(pair_index, z)
+            for ref, body in self._own(which):
+                m = sign * ((teeth - ref + z // 2) % z - z // 2)
+                out |= np.any(np.isin(m, body.inf.load_offsets) & valid, axis=1)
+            for w, t in self.marked:
+                if w == which:
+                    out |= np.any((teeth == t) & valid, axis=1)
+        return out
 
     def compliance(self, cand: Candidates) -> np.ndarray:
         """Compliance matrix of the candidates at the reference patch width [m^2/N per m]."""

@@ -21,6 +21,10 @@ Body frame and conventions
   centre (the tip is ``depth sin(angle)`` nearer the centreline than the mouth). It is a true
   discontinuity: the nodes on the crack line, except the tip, are duplicated so the two faces are
   free (LEFM). The mesh is refined around the crack tip.
+* A tooth breakage (optional, :mod:`geardyn.faults.breakage`) removes the tip of model tooth 0
+  above the radius ``r_a - Delta h``: that tooth is meshed with its involutes ending at that radius
+  and a circular arc of that radius as its tip (the cut), so its loaded flank (``"flank0"``) ends
+  at the cut.
 
 References
 ----------
@@ -42,7 +46,7 @@ from ...errors import InputError, NumericalError
 from ...geometry import Gear
 
 __all__ = ["MeshSettings", "CrackGeometry", "BodyMesh", "build_body_mesh", "loaded_flank",
-           "critical_fillet_point", "crack_segment", "tooth_offsets"]
+           "critical_fillet_point", "crack_segment", "tooth_offsets", "cut_flank", "check_cut"]
 
 #: Serialises every use of gmsh in this process. gmsh keeps one global model and is not
 #: thread-safe: two threads meshing at once (a Dask worker with several threads, say) crash the
@@ -134,6 +138,9 @@ class BodyMesh:
     crack_mouth, crack_tip : ndarray or None
         Crack end points in the body frame [m].
     settings : MeshSettings
+    info : dict
+    cut_radius : float or None
+        Radius of the cut of a broken model tooth 0 [m] (``None``: no breakage).
     """
 
     p: np.ndarray
@@ -146,6 +153,7 @@ class BodyMesh:
     crack_tip: np.ndarray | None
     settings: MeshSettings
     info: dict = field(default_factory=dict)
+    cut_radius: float | None = None
 
     @property
     def n_nodes(self) -> int:
@@ -248,8 +256,36 @@ def crack_segment(gear: Gear, crack: CrackGeometry) -> tuple[np.ndarray, np.ndar
     return mouth, tip
 
 
+def cut_flank(gear: Gear, cut_radius: float, n: int) -> np.ndarray:
+    """Loaded involute of tooth 0 from the form circle to the cut radius, ``n`` points [m].
+
+    The points of :func:`loaded_flank` below the cut, ending on the exact involute point at the
+    cut radius (:func:`geardyn.stiffness.fe.solve.flank_points`)."""
+    from .solve import flank_points
+
+    inv, _ = loaded_flank(gear, n)
+    rb = gear.base_radius
+    u_c = math.sqrt(cut_radius ** 2 - rb ** 2)
+    end = flank_points(gear, 0, np.array([u_c]))[0][:, 0]
+    r = np.hypot(*inv.T)
+    keep = inv[r < cut_radius - 1e-3 * (cut_radius - r[0])]
+    return np.vstack([keep, end])
+
+
+def check_cut(gear: Gear, cut_radius: float, field: str = "breakage.height") -> None:
+    """Raise :class:`InputError` unless a cut at ``cut_radius`` leaves a loaded flank of at
+    least a tenth of the involute above the form circle (the FE loads it there)."""
+    rf, ra = gear.form_radius, gear.tip_radius
+    lo = rf + 0.1 * (ra - rf)
+    if not (lo <= cut_radius <= ra):
+        raise InputError(field, ra - cut_radius,
+                         f"for the FE method a height lost in [0, {ra - lo:.4g}] m, which "
+                         f"leaves at least a tenth of the involute above the form circle "
+                         f"(radius {rf:.6g} m) as a flank to load")
+
+
 def build_body_mesh(gear: Gear, settings: MeshSettings, crack: CrackGeometry | None = None,
-                    *, n_points: int = 150) -> BodyMesh:
+                    *, n_points: int = 150, cut_radius: float | None = None) -> BodyMesh:
     """Mesh a whole gear body with gmsh (run in-process, single thread, no GUI).
 
     Parameters
@@ -262,6 +298,8 @@ def build_body_mesh(gear: Gear, settings: MeshSettings, crack: CrackGeometry | N
         Root crack on model tooth 0.
     n_points : int
         Points per involute and per fillet of the refined teeth (splines through them).
+    cut_radius : float, optional
+        Tooth breakage: model tooth 0 ends at this radius [m] (:func:`check_cut`).
 
     Returns
     -------
@@ -279,6 +317,10 @@ def build_body_mesh(gear: Gear, settings: MeshSettings, crack: CrackGeometry | N
     mouth = tip = None
     if crack is not None:
         mouth, tip = crack_segment(gear, crack)
+    inv_cut = None
+    if cut_radius is not None:
+        check_cut(gear, cut_radius)
+        inv_cut = cut_flank(gear, cut_radius, n_points)
 
     # gmsh is a process-wide singleton and not thread-safe: one mesh at a time per process
     with _GMSH_LOCK:
@@ -309,6 +351,8 @@ def build_body_mesh(gear: Gear, settings: MeshSettings, crack: CrackGeometry | N
                 j = k if k <= z // 2 else k - z
                 refined = j in offsets
                 inv, fil = (inv_r, fil_r) if refined else (inv_c, fil_c)
+                if inv_cut is not None and j == 0:
+                    inv = inv_cut  # the broken tooth: both involutes end at the cut radius
                 rot = _rot(2 * math.pi * j / z)
                 # unloaded (clockwise, x > 0) side: mirror of the loaded one
                 r_fil = (rot @ (fil * [-1, 1]).T).T  # form -> root
@@ -480,7 +524,8 @@ def build_body_mesh(gear: Gear, settings: MeshSettings, crack: CrackGeometry | N
         edges["crack+"] = plus
         edges["crack-"] = minus
     return BodyMesh(p=p, t=tri, edges=edges, offsets=offsets, gear=gear, crack=crack,
-                    crack_mouth=mouth, crack_tip=tip, settings=settings, info=info)
+                    crack_mouth=mouth, crack_tip=tip, settings=settings, info=info,
+                    cut_radius=None if cut_radius is None else float(cut_radius))
 
 
 def _orient_by_radius(p: np.ndarray, seg: np.ndarray) -> np.ndarray:

@@ -26,16 +26,19 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from ...errors import DataFileError, InputError
+from ...errors import DataFileError, InputError, NumericalError
 from ...geometry import Gear
-from ._batch import solve_batch
+from ._batch import solve_batch, solve_compatibility_fast
 from .contact import (
     BodyCompliance,
     CandidateGenerator,
     Candidates,
+    ContactResult,
     PairContactModel,
     candidates,
+    solve_compatibility,
 )
+from .faults import band_candidates, combine_bands, fault_gap
 from .mesh import CrackGeometry, MeshSettings, build_body_mesh
 from .solve import (
     BodyInfluence,
@@ -109,24 +112,31 @@ class FESettings:
 
 
 def body_inputs(gear: Gear, material: ElasticMaterial, settings: FESettings,
-                crack: CrackGeometry | None) -> dict:
-    """Everything a body's influence coefficients depend on (hashed for the cache)."""
+                crack: CrackGeometry | None, cut_radius: float | None = None) -> dict:
+    """Everything a body's influence coefficients depend on (hashed for the cache; a body
+    without a cut keeps the key it had before breakage was modelled)."""
     from ..._version import __version__
 
     g = asdict(gear)
     g.pop("face_width", None)  # 2-D per unit width: the face width enters later
     s = asdict(settings)
     s.pop("torque")
-    return {"geardyn": __version__, "format": FORMAT_VERSION, "gear": g,
-            "material": asdict(material), "settings": s,
-            "crack": None if crack is None else asdict(crack)}
+    out = {"geardyn": __version__, "format": FORMAT_VERSION, "gear": g,
+           "material": asdict(material), "settings": s,
+           "crack": None if crack is None else asdict(crack)}
+    if cut_radius is not None:
+        out["cut_radius"] = float(cut_radius)
+    return out
 
 
 def body_influence(gear: Gear, material: ElasticMaterial, settings: FESettings,
                    crack: CrackGeometry | None = None, *, cache=None,
-                   progress: Callable[[int, int], None] | None = None
-                   ) -> tuple[BodyInfluence, bool]:
+                   progress: Callable[[int, int], None] | None = None,
+                   cut_radius: float | None = None) -> tuple[BodyInfluence, bool]:
     """Flank influence coefficients of one body, from the cache or computed.
+
+    ``crack`` and ``cut_radius`` [m] (a broken tooth's cut) make model tooth 0 faulty; a faulty
+    body is loaded on every refined tooth.
 
     Returns
     -------
@@ -137,21 +147,24 @@ def body_influence(gear: Gear, material: ElasticMaterial, settings: FESettings,
 
     settings.check()
     cache = cache or default_cache()
-    key = cache_key(body_inputs(gear, material, settings, crack))
+    key = cache_key(body_inputs(gear, material, settings, crack, cut_radius))
 
     def build() -> BodyInfluence:
         t0 = time.perf_counter()
-        mesh = build_body_mesh(gear, settings.mesh_settings(), crack)
+        mesh = build_body_mesh(gear, settings.mesh_settings(), crack, cut_radius=cut_radius)
         t_mesh = time.perf_counter() - t0
         body = ElasticBody(mesh, material)
         u = load_roll_lengths(gear, settings.n_points)
-        loads = (0,) if crack is None else mesh.offsets
+        loads = (0,) if crack is None and cut_radius is None else mesh.offsets
+        by = None if cut_radius is None else \
+            {0: load_roll_lengths(gear, settings.n_points, cut_radius)}
         inf = influence_matrices(body, u, settings.half_width, load_offsets=loads,
-                                 progress=progress)
+                                 progress=progress, u_by_offset=by)
         stats = {**inf.stats, "t_mesh": t_mesh, "t_total": time.perf_counter() - t0}
         return BodyInfluence(u=inf.u, load_offsets=inf.load_offsets,
                              read_offsets=inf.read_offsets, H=inf.H, half_width=inf.half_width,
-                             plane_modulus=inf.plane_modulus, stats=stats, inputs_hash=key)
+                             plane_modulus=inf.plane_modulus, stats=stats, inputs_hash=key,
+                             u_teeth=inf.u_teeth)
 
     def load(path) -> BodyInfluence:
         obj = BodyInfluence.load(path)
@@ -176,6 +189,11 @@ def _row(cand: Candidates, q: int) -> Candidates:
     return Candidates(**{k: getattr(cand, k)[q] for k in Candidates.__dataclass_fields__})
 
 
+def _rows(cand: Candidates, q: np.ndarray) -> Candidates:
+    """Positions ``q`` of a block of candidates, as a block."""
+    return Candidates(**{k: getattr(cand, k)[q] for k in Candidates.__dataclass_fields__})
+
+
 class FEStiffness:
     """FE mesh stiffness of a case at any pinion angle and centre distance change.
 
@@ -183,7 +201,9 @@ class FEStiffness:
     ----------
     case : geardyn.config.Case
     cracked : bool
-        Include the case's crack (if enabled).
+        Include the case's faults: an enabled ``[crack]`` and the ``faults`` list
+        (:func:`geardyn.faults.faults_from_case`; what the FE does with each:
+        :mod:`.faults`). ``False``: the healthy pair.
     cache : geardyn.cache.Cache, optional
     progress : callable, optional
         ``progress(done, total)`` over the bodies to build.
@@ -196,37 +216,89 @@ class FEStiffness:
     def __init__(self, case, *, cracked: bool = True, cache=None,
                  progress: Callable[[int, int], None] | None = None, n_points: int = 48,
                  settings: FESettings | None = None):
+        from ...faults import faults_from_case
+        from .faults import body_faults, check_fe_faults, face_bands
+
         self.case = case
         self.pair = case.gear_pair()
         self.settings = settings or FESettings.from_case(case, n_points=n_points)
         mat = ElasticMaterial(float(case.material.youngs_modulus),
                               float(case.material.poisson_ratio), self.settings.plane)
         self.material = mat
-        crack = _crack_of(case, cracked)
-        self.crack = crack
-        jobs = [("pinion", self.pair.pinion, None), ("gear", self.pair.gear, None)]
-        if crack is not None:
-            g = self.pair.pinion if case.crack.gear == "pinion" else self.pair.gear
-            jobs.append(("cracked", g, crack))
+        self.face_width = float(case.pair.face_width)
+        #: the case's faults (validated; zero-size faults kept here, left out of the model)
+        self.faults = faults_from_case(case) if cracked else ()
+        active = tuple(f for f in self.faults if not f.is_null())
+        self.active_faults = active
+        check_fe_faults(active, self.pair, self.settings.refined_teeth)
+        #: bands across the face (:func:`.faults.face_bands`); one band without faults
+        self.bands = face_bands(active, self.face_width, self.pair)
+        cracks = [f for f in active if f.kind == "root_crack"]
+        #: geometry of the first root crack (the ``[crack]`` section's when enabled)
+        self.crack = None if not cracks else CrackGeometry(depth=float(cracks[0].depth),
+                                                           angle=float(cracks[0].angle))
+        gears = {"pinion": self.pair.pinion, "gear": self.pair.gear}
+        jobs = [("pinion", self.pair.pinion, None, None), ("gear", self.pair.gear, None, None)]
+        names: dict[tuple, str] = {}
+        for (which, tooth), keys in body_faults(self.bands).items():
+            for i, bk in enumerate(sorted(keys, key=repr)):
+                name = f"{which}{tooth}" + (f"_{i}" if len(keys) > 1 else "")
+                names[(which, tooth, bk)] = name
+                jobs.append((name, gears[which], bk[0], bk[1]))
         self.influence: dict[str, BodyInfluence] = {}
         self.from_cache: dict[str, bool] = {}
-        for k, (name, gear, cr) in enumerate(jobs):
-            inf, hit = body_influence(gear, mat, self.settings, cr, cache=cache)
+        for k, (name, gear, cr, cut) in enumerate(jobs):
+            inf, hit = body_influence(gear, mat, self.settings, cr, cache=cache,
+                                      cut_radius=cut)
             self.influence[name] = inf
             self.from_cache[name] = hit
             if progress is not None:
                 progress(k + 1, len(jobs))
+        if len(jobs) == 3:  # one faulty body: also under the [crack] model's name
+            self.influence["cracked"] = self.influence[jobs[2][0]]
         teeth = {"pinion": self.pair.pinion.teeth, "gear": self.pair.gear.teeth}
-        if crack is not None:
-            teeth["cracked"] = teeth[case.crack.gear]
-        comp = {k: BodyCompliance(v, teeth[k]) for k, v in self.influence.items()}
-        self.model = PairContactModel(
-            self.pair, comp["pinion"], comp["gear"], cracked=comp.get("cracked"),
-            crack_gear=case.crack.gear if crack is not None else "pinion",
-            crack_tooth=case.crack.tooth if crack is not None else 0,
-            plane_modulus=(mat.plane_modulus, mat.plane_modulus),
-            half_width=self.settings.half_width)
-        self.face_width = float(case.pair.face_width)
+        comp = {"pinion": BodyCompliance(self.influence["pinion"], teeth["pinion"]),
+                "gear": BodyCompliance(self.influence["gear"], teeth["gear"])}
+        for (which, _tooth, _bk), name in names.items():
+            comp[name] = BodyCompliance(self.influence[name], teeth[which])
+        kw = {"plane_modulus": (mat.plane_modulus, mat.plane_modulus),
+              "half_width": self.settings.half_width}
+
+        def contact_model(bodies, marked):
+            return PairContactModel(self.pair, comp["pinion"], comp["gear"], bodies=bodies,
+                                    marked=marked, **kw)
+
+        #: one :class:`PairContactModel` per band
+        self.band_models = []
+        union: dict[tuple[str, int], BodyCompliance] = {}
+        faulty: set[tuple[str, int]] = set()
+        for band in self.bands:
+            bodies, marked = {}, []
+            for (which, tooth), st in band.teeth:
+                faulty.add((which, tooth))
+                if st.body is None:
+                    marked.append((which, tooth))
+                else:
+                    bodies[(which, tooth)] = comp[names[(which, tooth, st.body)]]
+                    union.setdefault((which, tooth), bodies[(which, tooth)])
+            self.band_models.append(contact_model(bodies, marked))
+        #: the band's model (one band), else the model whose faulty teeth are every band's (it
+        #: decides which positions involve a fault)
+        self.model = self.band_models[0] if len(self.bands) == 1 else \
+            contact_model(union, [k for k in faulty if k not in union])
+        #: wear faults (recorded as ``fault_gap``)
+        self.wear = tuple(f for f in active if f.kind == "wear")
+
+    @property
+    def period_cycles(self) -> int | None:
+        """Mesh cycles of the map's period: ``None`` (one pinion revolution) unless a gear tooth
+        is faulty: ``z2`` (one gear revolution), or ``lcm(z1, z2)`` with faults on both (as
+        :attr:`geardyn.stiffness.pem.fault_model.FaultPEMModel.period_cycles`)."""
+        gears = {f.gear for f in self.active_faults}
+        z1, z2 = self.pair.pinion.teeth, self.pair.gear.teeth
+        if "gear" not in gears:
+            return None
+        return z2 if "pinion" not in gears else math.lcm(z1, z2)
 
     #: :meth:`evaluate` batched over the positions of one centre distance (candidates,
     #: compliances and contact problems each in a few vectorised or compiled calls,
@@ -241,8 +313,50 @@ class FEStiffness:
         return self.settings.torque / self.face_width
 
     def solve(self, theta: float, dd: float):
-        """Candidates and :class:`ContactResult` at ``(theta, dd)`` (forces per unit width)."""
-        return self.model.solve(theta, dd, self.torque_per_width)
+        """Candidates and :class:`ContactResult` at ``(theta, dd)`` (forces per unit width; with
+        several bands across the face the forces are the bands' total over the face divided by
+        the face width, the separation that of the first band)."""
+        if len(self.bands) == 1:
+            cand = candidates(self.pair, theta, dd)
+            cb = band_candidates(cand, self.bands[0], self.pair, dd)
+            return cb, self.model.solve_candidates(cb, self.torque_per_width)
+        cand = candidates(self.pair, theta, dd)
+        force, rot = self._solve_bands(cand, dd, compiled=False)
+        return cand, ContactResult(force=force, rotation=rot, separation=np.zeros(force.size),
+                                   iterations=0)
+
+    def _solve_bands(self, cand: Candidates, dd: float, *, compiled: bool,
+                     c0: list[np.ndarray] | None = None) -> tuple[np.ndarray, float]:
+        """Bands across the face in parallel at one position (:func:`.faults.combine_bands`).
+
+        Returns the total contact force of each candidate over the face divided by the face
+        width [N/m] and the pinion hub rotation [rad]. ``compiled``: each band's contact problem
+        by :func:`._batch.solve_compatibility_fast` (falling back to the reference where it
+        fails), else :func:`.contact.solve_compatibility`; ``c0``: the bands' compliance
+        matrices if already computed.
+        """
+        cbs = [band_candidates(cand, b, self.pair, dd) for b in self.bands]
+        if c0 is None:
+            c0 = [m.compliance(c) for m, c in zip(self.band_models, cbs, strict=True)]
+
+        def solve(k: int, tau: float):
+            m, cb = self.band_models[k], cbs[k]
+            if compiled:
+                try:
+                    res = solve_compatibility_fast(
+                        c0[k], cb.gap, cb.arm, tau, cb.radius, plane_modulus=(m.e1, m.e2),
+                        half_width=m.half_width, local=m.local_enabled)
+                    return res.force, res.rotation
+                except NumericalError:
+                    pass
+            local = (lambda f: m.local_term(cb, f)) if m.local_enabled else None
+            res = solve_compatibility(c0[k], cb.gap, cb.arm, tau, local)
+            return res.force, res.rotation
+
+        w = np.array([b.width for b in self.bands])
+        force, rot, _ = combine_bands(w, [c.gap for c in cbs], [c.arm for c in cbs], solve,
+                                      self.settings.torque)
+        return (w[:, None] * force).sum(axis=0) / self.face_width, rot
 
     def evaluate(self, theta: np.ndarray, dd: float, *, compiled: bool | None = None
                  ) -> dict[str, np.ndarray]:
@@ -290,12 +404,16 @@ class FEStiffness:
             cyclic = not self.model.involves_crack(cand)
             hit = memo.get(key) if cyclic else None
             if hit is None:
-                res = self.model.solve_candidates(cand, self.torque_per_width)
-                f = res.force
+                if cyclic or len(self.bands) == 1:
+                    cb = cand if cyclic else band_candidates(cand, self.bands[0], pair, dd)
+                    res = self.model.solve_candidates(cb, self.torque_per_width)
+                    f, rotation = res.force, res.rotation
+                else:
+                    f, rotation = self._solve_bands(cand, dd, compiled=False)
                 tot = f.sum()
                 shares = tuple((int(p - n_exit), float(x / tot))
                                for p, x in zip(cand.pair, f, strict=True))
-                hit = (res.rotation, shares, int(np.sum(f > 1e-9 * tot)))
+                hit = (rotation, shares, int(np.sum(f > 1e-9 * tot)))
                 if cyclic:
                     memo[key] = hit
             rot, shares, npc = hit
@@ -307,8 +425,15 @@ class FEStiffness:
                 elif r == 0:
                     exiting[i] = x
             npair[i] = npc
-        return {"k_mb": k_mb, "load_share": share, "load_share_exiting": exiting,
-                "pairs_in_contact": npair, "transmission_error": te}
+        out = {"k_mb": k_mb, "load_share": share, "load_share_exiting": exiting,
+               "pairs_in_contact": npair, "transmission_error": te}
+        return self._with_gap(out, theta, dd)
+
+    def _with_gap(self, out: dict, theta: np.ndarray, dd: float) -> dict:
+        """Add ``fault_gap`` [m] (n, 3) when a tooth is worn (:func:`.faults.fault_gap`)."""
+        if self.wear:
+            out["fault_gap"] = fault_gap(self.pair, self.wear, theta, dd)
+        return out
 
     def _evaluate_batched(self, theta: np.ndarray, dd: float) -> dict[str, np.ndarray]:
         """:meth:`evaluate` of all positions of one centre distance in a few batched calls.
@@ -350,17 +475,28 @@ class FEStiffness:
         share = np.zeros((npos, 3))
         exiting = np.zeros(npos)
         npair = np.zeros(npos)
+        multi = len(self.bands) > 1
         for size in np.unique(count[solved]):
             rows = solved[count[solved] == size]
             cand = gen.block(s_theta[rows], last[rows], int(size))
-            c0 = cm.compliance_batch(cand)
-            status, f, dth, _, _ = solve_batch(
-                c0, cand.gap, cand.arm, torque, cand.radius, plane_modulus=(cm.e1, cm.e2),
-                half_width=cm.half_width, local=cm.local_enabled)
-            for q in np.nonzero(status)[0]:  # fallback: the pure-Python reference
-                res = cm.solve_candidates(_row(cand, int(q)), torque)
-                f[q] = res.force
-                dth[q] = res.rotation
+            if multi:  # the positions on a faulty tooth: bands across the face, one by one
+                f = np.zeros((rows.size, int(size)))
+                dth = np.zeros(rows.size)
+                banded = ~cyclic[rows]
+                if banded.any():
+                    sub = _rows(cand, np.nonzero(banded)[0])
+                    c0s = [m.compliance_batch(band_candidates(sub, b, pair, dd))
+                           for m, b in zip(self.band_models, self.bands, strict=True)]
+                    for q, r in enumerate(np.nonzero(banded)[0]):
+                        f[r], dth[r] = self._solve_bands(_row(sub, q), dd, compiled=True,
+                                                         c0=[c[q] for c in c0s])
+                plain = np.nonzero(~banded)[0]
+                if plain.size:
+                    sub = _rows(cand, plain)
+                    f[plain], dth[plain] = self._solve_block(sub, torque)
+            else:
+                cand = band_candidates(cand, self.bands[0], pair, dd)
+                f, dth = self._solve_block(cand, torque)
             tot = f.sum(axis=1)
             rel = cand.pair - n_exit[rows][:, None]
             x = f / tot[:, None]
@@ -373,9 +509,36 @@ class FEStiffness:
             rot[rows] = dth
             npair[rows] = np.sum(f > 1e-9 * tot[:, None], axis=1)
         te = rot[src]
-        return {"k_mb": self.settings.torque / te / rb1 ** 2, "load_share": share[src],
-                "load_share_exiting": exiting[src], "pairs_in_contact": npair[src],
-                "transmission_error": te}
+        out = {"k_mb": self.settings.torque / te / rb1 ** 2, "load_share": share[src],
+               "load_share_exiting": exiting[src], "pairs_in_contact": npair[src],
+               "transmission_error": te}
+        return self._with_gap(out, theta, dd)
+
+    def _solve_block(self, cand: Candidates, torque: float) -> tuple[np.ndarray, np.ndarray]:
+        """Contact forces [N/m] and rotations [rad] of a block of positions with one band
+        (compiled :func:`._batch.solve_batch`, the reference where it fails)."""
+        cm = self.model
+        c0 = cm.compliance_batch(cand)
+        status, f, dth, _, _ = solve_batch(
+                c0, cand.gap, cand.arm, torque, cand.radius, plane_modulus=(cm.e1, cm.e2),
+                half_width=cm.half_width, local=cm.local_enabled)
+        for q in np.nonzero(status)[0]:  # fallback: the pure-Python reference
+            res = cm.solve_candidates(_row(cand, int(q)), torque)
+            f[q] = res.force
+            dth[q] = res.rotation
+        return f, dth
+
+    def _parameters(self) -> dict:
+        crack = next((f for f in self.active_faults if f.kind == "root_crack"), None)
+        out = {"crack": None if crack is None else {
+            "gear": crack.gear, "tooth": int(crack.tooth), "depth_m": float(crack.depth),
+            "angle_rad": float(crack.angle),
+            "mouth": "loaded fillet, 30 deg tangent point (ISO 6336-3)"}}
+        if getattr(self.case, "faults", None) and self.faults:
+            from ..pem.fault_model import fault_record
+
+            out["faults"] = [fault_record(f) for f in self.faults]
+        return out
 
     def attrs(self) -> dict:
         """Provenance of maps made by this model."""
@@ -396,11 +559,10 @@ class FEStiffness:
             "elements": "P2 triangles (scikit-fem), whole gear bodies fixed at the bore",
             "dofs": {k: int(v.get("dofs", 0)) for k, v in st.items()},
             "crack": None if self.crack is None else asdict(self.crack),
-            "parameters": {"crack": None if self.crack is None else {
-                "gear": self.case.crack.gear, "tooth": int(self.case.crack.tooth),
-                "depth_m": self.crack.depth, "angle_rad": self.crack.angle,
-                "mouth": "loaded fillet, 30 deg tangent point (ISO 6336-3)"}},
-            "cracked": int(self.crack is not None),
+            "parameters": self._parameters(),
+            "cracked": int(bool(self.active_faults)),
+            "face_bands": [{"width_m": b.width, "faulty_teeth": [
+                f"{w} {t}" for (w, t), _ in b.teeth]} for b in self.bands],
             "case": self.case.name,
             "citations": [
                 "Xue & Howard (2018) Mech. Syst. Signal Process., section 3",

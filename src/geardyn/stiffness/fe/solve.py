@@ -135,14 +135,17 @@ def flank_points(gear, offset: int, u: np.ndarray) -> tuple[np.ndarray, np.ndarr
     return x, n_in
 
 
-def load_roll_lengths(gear, n: int) -> np.ndarray:
+def load_roll_lengths(gear, n: int, tip_radius: float | None = None) -> np.ndarray:
     """Roll lengths of the load points on a flank [m]: from just above the form circle to the tip,
     clustered towards the tip (where the compliance changes fastest),
-    ``u = u_lo + (u_tip - u_lo)(1 - (1 - xi)^1.5)`` for ``xi`` uniform in [0, 1]."""
+    ``u = u_lo + (u_tip - u_lo)(1 - (1 - xi)^1.5)`` for ``xi`` uniform in [0, 1].
+
+    ``tip_radius`` [m]: where the flank ends (a broken tooth's cut); default the tip circle."""
     if n < 8:
         raise InputError("n_points", n, "at least 8 load points per flank")
     rb = gear.base_radius
-    u_tip = math.sqrt(gear.tip_radius ** 2 - rb ** 2)
+    ra = gear.tip_radius if tip_radius is None else float(tip_radius)
+    u_tip = math.sqrt(ra ** 2 - rb ** 2)
     u_form = math.sqrt(max(gear.form_radius ** 2 - rb ** 2, 0.0))
     u_lo = u_form + 0.02 * (u_tip - u_form)
     xi = np.linspace(0.0, 1.0, n)
@@ -347,6 +350,9 @@ class BodyInfluence:
     inputs_hash : str
         Cache key of the inputs these coefficients were computed for ("" when not cached); a
         cache entry whose stored hash differs from its key is rebuilt.
+    u_teeth : ndarray, shape (n_read, n_p), optional
+        Roll lengths of the points of each read tooth [m] when they differ from ``u`` (a broken
+        tooth's flank ends at its cut); ``None``: ``u`` on every tooth.
     """
 
     u: np.ndarray
@@ -357,15 +363,23 @@ class BodyInfluence:
     plane_modulus: float
     stats: dict = field(default_factory=dict)
     inputs_hash: str = ""
+    u_teeth: np.ndarray | None = None
+
+    def grid(self, offset: int) -> np.ndarray:
+        """Roll lengths of the points on model tooth ``offset`` [m]."""
+        if self.u_teeth is None:
+            return self.u
+        return self.u_teeth[self.read_offsets.index(offset)]
 
     def save(self, path) -> None:
         """Write to ``.npz`` (no pickle)."""
         stats = np.array([[k, repr(v)] for k, v in self.stats.items()], dtype=str)
+        extra = {} if self.u_teeth is None else {"u_teeth": self.u_teeth}
         with open(path, "wb") as fh:
             np.savez(fh, u=self.u, load_offsets=np.asarray(self.load_offsets),
                      read_offsets=np.asarray(self.read_offsets), H=self.H,
                      half_width=self.half_width, plane_modulus=self.plane_modulus, stats=stats,
-                     inputs_hash=np.array(self.inputs_hash))
+                     inputs_hash=np.array(self.inputs_hash), **extra)
 
     @classmethod
     def load(cls, path) -> BodyInfluence:
@@ -376,7 +390,8 @@ class BodyInfluence:
                        read_offsets=tuple(int(v) for v in d["read_offsets"]), H=d["H"].copy(),
                        half_width=float(d["half_width"]), plane_modulus=float(d["plane_modulus"]),
                        stats=stats,
-                       inputs_hash=str(d["inputs_hash"]) if "inputs_hash" in d.files else "")
+                       inputs_hash=str(d["inputs_hash"]) if "inputs_hash" in d.files else "",
+                       u_teeth=d["u_teeth"].copy() if "u_teeth" in d.files else None)
 
 
 def _isfloat(v) -> bool:
@@ -389,7 +404,7 @@ def _isfloat(v) -> bool:
 
 def influence_matrices(body: ElasticBody, u: np.ndarray, half_width: float, *,
                        load_offsets: tuple[int, ...] = (0,),
-                       progress=None) -> BodyInfluence:
+                       progress=None, u_by_offset: dict | None = None) -> BodyInfluence:
     """Influence coefficients of a body's loaded flanks (one factorisation, many solves).
 
     Parameters
@@ -403,6 +418,8 @@ def influence_matrices(body: ElasticBody, u: np.ndarray, half_width: float, *,
         Teeth to load (``(0,)`` for a healthy, cyclically symmetric body).
     progress : callable, optional
         ``progress(done, total)`` per loaded tooth.
+    u_by_offset : dict of int -> ndarray, optional
+        Other roll lengths (same count) on some teeth [m], e.g. a broken tooth's flank.
 
     Returns
     -------
@@ -414,16 +431,18 @@ def influence_matrices(body: ElasticBody, u: np.ndarray, half_width: float, *,
             raise InputError("load_offsets", i, f"refined teeth {read}")
     t0 = time.perf_counter()
     body.factor()
-    readouts = sp.vstack([body.readout(j, u) for j in read]).tocsr()
+    grids = {j: np.asarray((u_by_offset or {}).get(j, u), float) for j in read}
+    readouts = sp.vstack([body.readout(j, grids[j]) for j in read]).tocsr()
     H = np.empty((len(load_offsets), len(read), u.size, u.size))
     for a, i in enumerate(load_offsets):
-        X = body.solve(body.patch_loads(i, u, half_width))
+        X = body.solve(body.patch_loads(i, grids[i], half_width))
         H[a] = (readouts @ X).reshape(len(read), u.size, u.size)
         if progress is not None:
             progress(a + 1, len(load_offsets))
     stats = {"nodes": body.mesh.n_nodes, "triangles": body.mesh.n_triangles,
              "dofs": body.n_dofs, "t_assemble": body.t_assemble, "t_factor": body.t_factor,
              "t_solve": time.perf_counter() - t0 - body.t_factor}
+    u_teeth = np.stack([grids[j] for j in read]) if u_by_offset else None
     return BodyInfluence(u=np.asarray(u, float), load_offsets=tuple(load_offsets),
                          read_offsets=tuple(read), H=H, half_width=float(half_width),
-                         plane_modulus=body.material.plane_modulus, stats=stats)
+                         plane_modulus=body.material.plane_modulus, stats=stats, u_teeth=u_teeth)
