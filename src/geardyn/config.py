@@ -309,7 +309,15 @@ class FaultConfig(_Model):
 class FEConfig(_Model):
     """Finite-element mesh stiffness settings."""
 
-    torque: Torque = Field(100.0, gt=0, description="Torque on the pinion hub [N m] (paper: 100).")
+    torque: Torque | None = Field(
+        None, gt=0, description="Pinion hub torque the FE map is built at [N m]; omit for the "
+                                "case's operating torque motor.torque (paper: 100), so that a "
+                                "sweep over motor.torque gets the map of each torque.")
+    definition: Literal["secant", "tangent"] = Field(
+        "secant", description="FE mesh stiffness: 'secant' T / dtheta at the torque (the "
+                              "paper's FEA) or 'tangent' dT / dtheta there (central difference "
+                              "at T (1 +/- 0.05)), the incremental stiffness of small "
+                              "fluctuations about the mean load.")
     plane: Literal["strain", "stress"] = Field("strain", description="Plane strain or stress.")
     mesh_size: Length | None = Field(None, gt=0, description="Element size in the tooth zone "
                                                               "[m]; omit for the default.")

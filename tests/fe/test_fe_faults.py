@@ -218,7 +218,7 @@ def test_spall_linear_limit_is_the_effective_width(base, theta):
     # single contact also at the intact band's load, T L / (L - b_s) (else the neighbour in
     # extended contact carries part of it and the law is not the effective width)
     hi = FEStiffness(base, settings=dataclasses.replace(
-        coarse_settings(base), torque=base.stiffness.fe.torque * L / (L - sp.width)))
+        coarse_settings(base), torque=coarse_settings(base).torque * L / (L - sp.width)))
     single = linear(hi).evaluate(theta, 0.0)["pairs_in_contact"] == 1
     roll = s11 / pair.pinion.base_radius
     inside = (roll > sp.window[0]) & (roll < sp.window[1]) & single

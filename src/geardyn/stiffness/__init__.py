@@ -13,7 +13,7 @@ import numpy as np
 from .map import MapArrays, StiffnessMap, lookup, lookup_reference
 
 __all__ = ["StiffnessMap", "MapArrays", "lookup", "lookup_reference", "build_map",
-           "map_inputs", "centre_distance_grid"]
+           "map_inputs", "centre_distance_grid", "fe_torque"]
 
 
 def centre_distance_grid(case) -> np.ndarray:
@@ -24,6 +24,19 @@ def centre_distance_grid(case) -> np.ndarray:
 
 #: Bump when a method's physics or numerics change, so cached maps are rebuilt.
 MODEL_VERSIONS = {"pem": "1", "fe": "2"}
+
+
+def fe_torque(case) -> float:
+    """Pinion hub torque the FE map of a case is built at [N m].
+
+    ``[stiffness.fe] torque`` if given, else the case's operating torque ``motor.torque`` (the
+    constant law's input torque; the induction law's rated torque), so that the map is the
+    secant (or tangent) stiffness at the mean mesh load of the run. The potential-energy map
+    does not depend on the load (its Hertz term is Yang & Lin's linearised, load-independent
+    form, :func:`geardyn.stiffness.pem.hertz.hertz_compliance`).
+    """
+    t = case.stiffness.fe.torque
+    return float(case.motor.torque if t is None else t)
 
 
 def map_inputs(case, method: str, cracked: bool) -> dict:
@@ -48,7 +61,15 @@ def map_inputs(case, method: str, cracked: bool) -> dict:
         data["faults"] = [f.model_dump(mode="json") for f in case.faults]
         data["faults_version"] = "1"
     if method == "fe":
-        data["fe"] = case.stiffness.fe.model_dump(mode="json")
+        fe = case.stiffness.fe.model_dump(mode="json")
+        fe["torque"] = fe_torque(case)  # the resolved load: omitted = motor.torque
+        if fe["definition"] == "secant":  # the default keeps the keys of earlier secant maps
+            del fe["definition"]
+        else:
+            from .fe.model import TANGENT_STEP
+
+            fe["tangent_step"] = TANGENT_STEP
+        data["fe"] = fe
     else:
         data["body_torsion"] = case.stiffness.body_torsion
         if case.stiffness.foundation_half_angle != "fillet":  # the default keeps earlier keys

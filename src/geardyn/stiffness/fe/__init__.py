@@ -13,9 +13,12 @@ the real tooth shape, but factorises each gear body once:
    exact corner-to-flank gaps beyond it, so extended and tip contact appear under load) and
    solves compatibility with non-negative forces under the torque, with an analytical correction
    of the local Hertzian deformation to the actual contact width.
-4. :func:`fe_map` tabulates ``k_mb = K_t / r_b1^2`` (secant ``K_t = T / Delta theta``), the load
+4. :func:`fe_map` tabulates ``k_mb = K_t / r_b1^2`` (secant ``K_t = T / Delta theta``, or the
+   tangent ``dT / d(Delta theta)`` with ``[stiffness.fe] definition = "tangent"``), the load
    sharing ratio per pair, the number of pairs in contact and the static transmission error in a
-   :class:`geardyn.stiffness.StiffnessMap`.
+   :class:`geardyn.stiffness.StiffnessMap`, at the torque ``T`` of ``[stiffness.fe] torque``, by
+   default the case's operating torque ``motor.torque`` (:func:`geardyn.stiffness.fe_torque`;
+   docs/verification/stiffness.md 3.1).
 
 :mod:`.direct` solves the two bodies in contact directly (no influence coefficients, no assumed
 pressure distribution); it is the independent check of the load sharing and the "full FE solve
@@ -60,8 +63,8 @@ def fe_map(case, dd: np.ndarray, *, cracked: bool,
     Parameters
     ----------
     case : geardyn.config.Case
-        Geometry, material, ``[stiffness.fe]`` (torque, plane, mesh size, refinement, teeth in
-        model) and ``[crack]``.
+        Geometry, material, ``[stiffness.fe]`` (torque, by default ``motor.torque``; secant or
+        tangent definition; plane, mesh size, refinement, teeth in model) and ``[crack]``.
     dd : ndarray
         Centre distance changes [m] (uniform, increasing).
     cracked : bool

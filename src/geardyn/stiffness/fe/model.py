@@ -48,7 +48,7 @@ from .solve import (
     load_roll_lengths,
 )
 
-__all__ = ["FESettings", "body_influence", "FEStiffness", "FORMAT_VERSION"]
+__all__ = ["FESettings", "body_influence", "FEStiffness", "FORMAT_VERSION", "TANGENT_STEP"]
 
 #: bump when the stored influence data change meaning
 FORMAT_VERSION = 2
@@ -57,6 +57,9 @@ PATCH_FACTOR = 0.04  # b_ref / m
 MESH_FACTOR = 0.08  # default tooth-zone element size / m
 FLANK_RATIO = 8.0  # tooth size / flank size
 BODY_RATIO = 3.0  # body size / tooth size
+#: relative torque step h of the tangent stiffness, a central difference at T (1 +/- h) [-]
+TANGENT_STEP = 0.05
+DEFINITIONS = ("secant", "tangent")
 
 
 @dataclass(frozen=True)
@@ -66,7 +69,8 @@ class FESettings:
     Attributes
     ----------
     torque : float
-        Pinion torque [N m].
+        Pinion torque [N m] (``[stiffness.fe] torque``, by default the case's ``motor.torque``:
+        :func:`geardyn.stiffness.fe_torque`).
     plane : {"strain", "stress"}
     flank_size, tooth_size, body_size : float
         Element sizes on the loaded flanks, in the refined teeth and elsewhere [m].
@@ -76,6 +80,11 @@ class FESettings:
         Load points per flank.
     half_width : float
         Reference Hertz patch half-width ``b_ref`` [m].
+    definition : {"secant", "tangent"}
+        ``k_mb`` of the map: secant ``T / (dtheta r_b1^2)`` at ``torque``, or tangent
+        ``dT / dtheta / r_b1^2`` there (:meth:`FEStiffness.evaluate`).
+    tangent_step : float
+        Relative torque step ``h`` of the tangent's central difference [-].
     """
 
     torque: float
@@ -86,17 +95,21 @@ class FESettings:
     refined_teeth: int
     n_points: int
     half_width: float
+    definition: str = "secant"
+    tangent_step: float = TANGENT_STEP
 
     @classmethod
     def from_case(cls, case, *, n_points: int = 48) -> FESettings:
         """Settings of a :class:`geardyn.config.Case`."""
+        from .. import fe_torque
+
         fe = case.stiffness.fe
         m = case.pair.module
         tooth = (fe.mesh_size if fe.mesh_size is not None else MESH_FACTOR * m) / fe.refinement
-        return cls(torque=float(fe.torque), plane=fe.plane, flank_size=tooth / FLANK_RATIO,
+        return cls(torque=fe_torque(case), plane=fe.plane, flank_size=tooth / FLANK_RATIO,
                    tooth_size=tooth, body_size=BODY_RATIO * tooth,
                    refined_teeth=int(fe.teeth_in_model), n_points=int(n_points),
-                   half_width=PATCH_FACTOR * m)
+                   half_width=PATCH_FACTOR * m, definition=str(fe.definition))
 
     def mesh_settings(self) -> MeshSettings:
         """The :class:`MeshSettings` of the body meshes."""
@@ -104,7 +117,14 @@ class FESettings:
                             body_size=self.body_size, refined_teeth=self.refined_teeth)
 
     def check(self) -> None:
-        """Raise :class:`InputError` if the patch is not resolved by the flank mesh."""
+        """Raise :class:`InputError` if the patch is not resolved by the flank mesh, or the
+        torque or the stiffness definition is not valid."""
+        if not (math.isfinite(self.torque) and self.torque > 0):
+            raise InputError("stiffness.fe.torque", self.torque, "a finite torque > 0 [N m]")
+        if self.definition not in DEFINITIONS:
+            raise InputError("stiffness.fe.definition", self.definition, "'secant' or 'tangent'")
+        if not 0 < self.tangent_step < 1:
+            raise InputError("tangent_step", self.tangent_step, "a relative step in (0, 1)")
         if self.flank_size > self.half_width:
             raise InputError("stiffness.fe.mesh_size", self.tooth_size,
                              f"a tooth-zone size <= {FLANK_RATIO * self.half_width:.4g} m so that "
@@ -120,7 +140,8 @@ def body_inputs(gear: Gear, material: ElasticMaterial, settings: FESettings,
     g = asdict(gear)
     g.pop("face_width", None)  # 2-D per unit width: the face width enters later
     s = asdict(settings)
-    s.pop("torque")
+    for k in ("torque", "definition", "tangent_step"):  # the bodies are linear: load-free
+        s.pop(k)
     out = {"geardyn": __version__, "format": FORMAT_VERSION, "gear": g,
            "material": asdict(material), "settings": s,
            "crack": None if crack is None else asdict(crack)}
@@ -326,15 +347,18 @@ class FEStiffness:
                                    iterations=0)
 
     def _solve_bands(self, cand: Candidates, dd: float, *, compiled: bool,
-                     c0: list[np.ndarray] | None = None) -> tuple[np.ndarray, float]:
+                     c0: list[np.ndarray] | None = None, torque: float | None = None
+                     ) -> tuple[np.ndarray, float]:
         """Bands across the face in parallel at one position (:func:`.faults.combine_bands`).
 
         Returns the total contact force of each candidate over the face divided by the face
         width [N/m] and the pinion hub rotation [rad]. ``compiled``: each band's contact problem
         by :func:`._batch.solve_compatibility_fast` (falling back to the reference where it
         fails), else :func:`.contact.solve_compatibility`; ``c0``: the bands' compliance
-        matrices if already computed.
+        matrices if already computed; ``torque``: the pinion torque [N m] (default
+        ``settings.torque``).
         """
+        torque = self.settings.torque if torque is None else float(torque)
         cbs = [band_candidates(cand, b, self.pair, dd) for b in self.bands]
         if c0 is None:
             c0 = [m.compliance(c) for m, c in zip(self.band_models, cbs, strict=True)]
@@ -355,12 +379,21 @@ class FEStiffness:
 
         w = np.array([b.width for b in self.bands])
         force, rot, _ = combine_bands(w, [c.gap for c in cbs], [c.arm for c in cbs], solve,
-                                      self.settings.torque)
+                                      torque)
         return (w[:, None] * force).sum(axis=0) / self.face_width, rot
 
     def evaluate(self, theta: np.ndarray, dd: float, *, compiled: bool | None = None
                  ) -> dict[str, np.ndarray]:
         """Map variables at pinion angles ``theta`` [rad] and change ``dd`` [m].
+
+        Everything at the settings' torque ``T`` [N m]. ``k_mb`` is the secant
+        ``T / (dtheta(T) r_b1^2)`` (``settings.definition = "secant"``, the paper's FEA), or the
+        tangent ``dT / dtheta / r_b1^2`` at ``T`` (``"tangent"``): the central difference
+        ``2 h T / ((dtheta(T (1 + h)) - dtheta(T (1 - h))) r_b1^2)`` with
+        ``h = settings.tangent_step`` (:data:`TANGENT_STEP` = 0.05), from two more evaluations
+        at those torques (the incremental stiffness of a small fluctuation of the mesh force
+        about its mean). The contact law stiffens with the load (Hertzian local term, gaps
+        closing), so the tangent exceeds the secant (tests/fe/test_load_consistent.py).
 
         ``compiled`` (default :attr:`compiled`): all positions of this centre distance at once
         (:meth:`_evaluate_batched`); ``False`` runs the per-position pure-Python reference
@@ -384,8 +417,27 @@ class FEStiffness:
         """
         theta = np.atleast_1d(np.asarray(theta, float))
         compiled = self.compiled if compiled is None else bool(compiled)
+        s = self.settings
+        out = self.evaluate_at(theta, dd, s.torque, compiled=compiled)
+        if s.definition == "tangent":
+            h = s.tangent_step
+            hi = self.evaluate_at(theta, dd, s.torque * (1 + h), compiled=compiled)
+            lo = self.evaluate_at(theta, dd, s.torque * (1 - h), compiled=compiled)
+            rb1 = self.pair.pinion.base_radius
+            out["k_mb"] = 2 * h * s.torque / (hi["transmission_error"]
+                                              - lo["transmission_error"]) / rb1 ** 2
+        return out
+
+    def evaluate_at(self, theta: np.ndarray, dd: float, torque: float, *,
+                    compiled: bool | None = None) -> dict[str, np.ndarray]:
+        """:meth:`evaluate`'s variables at pinion torque ``torque`` [N m] with the secant
+        ``k_mb = torque / (dtheta r_b1^2)`` [N/m], whatever ``settings.definition``."""
+        theta = np.atleast_1d(np.asarray(theta, float))
+        compiled = self.compiled if compiled is None else bool(compiled)
+        torque = float(torque)  # no solution for torque <= 0: NumericalError from the solve
         if compiled:
-            return self._evaluate_batched(theta, float(dd))
+            return self._evaluate_batched(theta, float(dd), torque)
+        tau = torque / self.face_width
         pair = self.pair
         rb1, pb = pair.pinion.base_radius, pair.base_pitch
         tm = pair.mesh_angle
@@ -406,10 +458,10 @@ class FEStiffness:
             if hit is None:
                 if cyclic or len(self.bands) == 1:
                     cb = cand if cyclic else band_candidates(cand, self.bands[0], pair, dd)
-                    res = self.model.solve_candidates(cb, self.torque_per_width)
+                    res = self.model.solve_candidates(cb, tau)
                     f, rotation = res.force, res.rotation
                 else:
-                    f, rotation = self._solve_bands(cand, dd, compiled=False)
+                    f, rotation = self._solve_bands(cand, dd, compiled=False, torque=torque)
                 tot = f.sum()
                 shares = tuple((int(p - n_exit), float(x / tot))
                                for p, x in zip(cand.pair, f, strict=True))
@@ -418,7 +470,7 @@ class FEStiffness:
                     memo[key] = hit
             rot, shares, npc = hit
             te[i] = rot
-            k_mb[i] = self.settings.torque / rot / rb1 ** 2
+            k_mb[i] = torque / rot / rb1 ** 2
             for r, x in shares:
                 if 1 <= r <= 3:
                     share[i, r - 1] = x
@@ -435,8 +487,10 @@ class FEStiffness:
             out["fault_gap"] = fault_gap(self.pair, self.wear, theta, dd)
         return out
 
-    def _evaluate_batched(self, theta: np.ndarray, dd: float) -> dict[str, np.ndarray]:
-        """:meth:`evaluate` of all positions of one centre distance in a few batched calls.
+    def _evaluate_batched(self, theta: np.ndarray, dd: float, torque: float
+                          ) -> dict[str, np.ndarray]:
+        """:meth:`evaluate_at` of all positions of one centre distance in a few batched calls
+        (pinion torque ``torque`` [N m]).
 
         The reference's arithmetic, reorganised: (1) the candidate pair indices of every
         position (:meth:`.contact.CandidateGenerator.span`) and the mesh-cycle memo decided up
@@ -454,7 +508,7 @@ class FEStiffness:
         rb1, pb = pair.pinion.base_radius, pair.base_pitch
         tm = pair.mesh_angle
         s_end = pair.operating(dd, check=False).s_end
-        torque = self.torque_per_width
+        tau = torque / self.face_width
         npos = theta.size
         gen = CandidateGenerator(pair, dd)
         s_theta, first, last = gen.span(theta)
@@ -489,14 +543,14 @@ class FEStiffness:
                            for m, b in zip(self.band_models, self.bands, strict=True)]
                     for q, r in enumerate(np.nonzero(banded)[0]):
                         f[r], dth[r] = self._solve_bands(_row(sub, q), dd, compiled=True,
-                                                         c0=[c[q] for c in c0s])
+                                                         c0=[c[q] for c in c0s], torque=torque)
                 plain = np.nonzero(~banded)[0]
                 if plain.size:
                     sub = _rows(cand, plain)
-                    f[plain], dth[plain] = self._solve_block(sub, torque)
+                    f[plain], dth[plain] = self._solve_block(sub, tau)
             else:
                 cand = band_candidates(cand, self.bands[0], pair, dd)
-                f, dth = self._solve_block(cand, torque)
+                f, dth = self._solve_block(cand, tau)
             tot = f.sum(axis=1)
             rel = cand.pair - n_exit[rows][:, None]
             x = f / tot[:, None]
@@ -509,7 +563,7 @@ class FEStiffness:
             rot[rows] = dth
             npair[rows] = np.sum(f > 1e-9 * tot[:, None], axis=1)
         te = rot[src]
-        out = {"k_mb": self.settings.torque / te / rb1 ** 2, "load_share": share[src],
+        out = {"k_mb": torque / te / rb1 ** 2, "load_share": share[src],
                "load_share_exiting": exiting[src], "pairs_in_contact": npair[src],
                "transmission_error": te}
         return self._with_gap(out, theta, dd)
@@ -550,8 +604,13 @@ class FEStiffness:
             "face_width_basis": f"2-D results per unit width times face width "
                                 f"b = {self.face_width:g} m",
             "torque": s.torque, "torque_units": "N m",
-            "stiffness_definition": "secant K_t = T / dtheta at the applied torque (gear hub "
-                                    "fixed, torque on the pinion hub), k_mb = K_t / r_b1^2",
+            "stiffness_definition": (
+                "secant K_t = T / dtheta at the applied torque (gear hub fixed, torque on the "
+                "pinion hub), k_mb = K_t / r_b1^2" if s.definition == "secant" else
+                f"tangent K_t = dT / dtheta at the applied torque T (gear hub fixed, torque on "
+                f"the pinion hub) by the central difference 2 h T / (dtheta(T (1 + h)) - "
+                f"dtheta(T (1 - h))), h = {s.tangent_step:g}, k_mb = K_t / r_b1^2; "
+                f"transmission_error and load_share at T"),
             "patch_half_width": s.half_width, "patch_half_width_units": "m",
             "flank_element_size": s.flank_size, "tooth_element_size": s.tooth_size,
             "body_element_size": s.body_size, "element_size_units": "m",
