@@ -188,8 +188,9 @@ def check_writable(target: OutputTarget, *, folder: bool = True) -> None:
             break
         probe = probe.parent
     if not probe.is_dir():
-        raise InputError(target.label, f"{_short(str(probe))} is a file, not a folder",
-                         "a path whose parent folders are folders")
+        raise InputError(target.label, _short(str(probe)),
+                         "a path whose parent folders are folders (this one is a file, not a "
+                         "folder)")
     try:
         fd, tmp = tempfile.mkstemp(prefix=".geardyn-write-test.", dir=probe)
     except OSError as exc:
