@@ -127,6 +127,12 @@ def case_differences(case, reference=None) -> tuple[list[dict], list[dict]]:
     ref = reference if reference is not None else paper_case()
     a = _flatten(deep_copy_case_data(ref), "", {})
     b = _flatten(deep_copy_case_data(case), "", {})
+    # the FE map's torque as used: omitted means the operating torque (stiffness.fe_torque)
+    from ..stiffness import fe_torque
+
+    for flat, c in ((a, ref), (b, case)):
+        if "stiffness.fe.torque" in flat or "motor.torque" in flat:
+            flat["stiffness.fe.torque"] = fe_torque(c)
     inputs, numerical = [], []
     for key in [*a, *(k for k in b if k not in a)]:
         if key in ("name", "description") or key.startswith("provenance"):
