@@ -60,7 +60,7 @@ runout tolerance was not found; runout is given as an amount.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -212,6 +212,10 @@ class GearDeviations:
     runout_phase: float = 0.0
     source: str = "none"
     tolerances: dict = field(default_factory=dict)
+    #: Wear faults of the ``faults`` list (:class:`geardyn.faults.Wear`) on this gear's teeth, as
+    #: ``(tooth, depth [m], u_a [m], u_b [m])``: a deviation ``depth`` over roll lengths
+    #: ``[u_a, u_b]`` of that tooth, added to its table.
+    wear: tuple = ()
 
     # ------------------------------------------------------------------ tables
     @property
@@ -227,7 +231,8 @@ class GearDeviations:
     @property
     def has_table(self) -> bool:
         """Whether any per-tooth deviation is non-zero."""
-        return bool(np.any(self.pitch) or np.any(self.slope) or np.any(self.form))
+        return bool(np.any(self.pitch) or np.any(self.slope) or np.any(self.form)
+                    or any(w[1] > 0 for w in self.wear))
 
     @property
     def has_relief(self) -> bool:
@@ -245,7 +250,10 @@ class GearDeviations:
         """Per-tooth deviation (pitch, slope, form) on ``u_lo + du * arange(N_ROLL)``,
         shape ``(teeth, N_ROLL)`` [m]; constant beyond the ends when interpolated."""
         u = self.u_lo + self.du * np.arange(N_ROLL)
-        return self.profile_exact(np.arange(self.teeth)[:, None], u[None, :])
+        tab = self.profile_exact(np.arange(self.teeth)[:, None], u[None, :])
+        for tooth, depth, ua, ub in self.wear:  # sampled at the nodes: edges ramp over du
+            tab[int(tooth) % self.teeth] += np.where((u >= ua) & (u <= ub), depth, 0.0)
+        return tab
 
     def profile_exact(self, tooth, u) -> np.ndarray:
         """Pitch + slope + form deviation of ``tooth`` at roll length ``u`` [m] (closed form,
@@ -375,9 +383,34 @@ class ToothModifications:
         pair = case.gear_pair()
         cfg = getattr(case, "modifications", None)
         if cfg is None:
-            return cls.none(pair)
-        return cls(pair, _gear_from_config(pair, "pinion", cfg.pinion, "modifications.pinion"),
-                   _gear_from_config(pair, "gear", cfg.gear, "modifications.gear"))
+            out = cls.none(pair)
+        else:
+            out = cls(pair,
+                      _gear_from_config(pair, "pinion", cfg.pinion, "modifications.pinion"),
+                      _gear_from_config(pair, "gear", cfg.gear, "modifications.gear"))
+        return out._with_wear(case)
+
+    def _with_wear(self, case) -> ToothModifications:
+        """Add the ``faults`` list's wear (:class:`geardyn.faults.Wear`, a uniform depth over a
+        roll window of one tooth: a profile deviation, :mod:`geardyn.faults.wear`) to the
+        deviation tables, so the dynamics and the static TE see the worn tooth's gap."""
+        if not getattr(case, "faults", None):
+            return self
+        from .faults import Wear, faults_from_case
+
+        wear = [f for f in faults_from_case(case, legacy_crack=False)
+                if isinstance(f, Wear) and not f.is_null()]
+        if not wear:
+            return self
+        gears = {"pinion": self.pinion, "gear": self.gear}
+        for f in wear:
+            g = gears[f.gear]
+            a, b = f.window  # roll angles [rad]
+            entry = (int(f.tooth), float(f.depth), a * g.base_radius, b * g.base_radius)
+            src = f"wear of tooth {f.tooth} ({f.depth * 1e6:.4g} um)"
+            gears[f.gear] = replace(g, wear=(*g.wear, entry),
+                                    source=src if g.source == "none" else f"{g.source}; {src}")
+        return ToothModifications(self.pair, gears["pinion"], gears["gear"])
 
     @property
     def active(self) -> bool:

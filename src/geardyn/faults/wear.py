@@ -10,8 +10,12 @@ positive where material is missing (the sign convention of :mod:`geardyn.modific
 What it does:
 
 * the **excitation / separation**: the worn tooth pair must close the gap ``e`` before it carries
-  load. The PEM map records the gap of each load-share slot (``fault_gap`` [m], extra variable
-  of the map); the dynamics does not read it yet (see the README's list of what is missing);
+  load. The PEM and FE maps record the gap of each load-share slot (``fault_gap`` [m], extra
+  variable of the map); the dynamics and the static TE take it from
+  :class:`geardyn.modifications.ToothModifications`, which adds ``e(u)`` to the worn tooth's
+  deviation table (sampled on its nodes: the window's edges ramp over one node spacing), so the
+  worn pair closes the gap before it carries load (``tests/faults/test_wear_dynamics.py``: the
+  static TE rises by exactly ``delta`` in single contact);
 * optionally (``stiffness = true``) the **stiffness**: the tooth is thinner. At a section of
   the worn band the half-thickness on the loaded side is smaller by ``delta / cos(alpha_1)``
   (the flank normal makes the angle ``alpha_1 = u - alpha_2`` with the tooth's transverse axis),
