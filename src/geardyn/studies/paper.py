@@ -125,15 +125,15 @@ def stiffness_stage(case: Case, out: Path, result: StudyResult) -> None:
     result.maps = {"healthy": healthy, "cracked": cracked}
     healthy.to_netcdf(out / "stiffness_healthy.nc")
     cracked.to_netcdf(out / "stiffness_cracked.nc")
-    result.figures["fig5_stiffness"] = fig_stiffness(healthy)
-    result.figures["fig5_load_sharing"] = fig_load_sharing(healthy)
+    result.figures.cached("fig5_stiffness", fig_stiffness, healthy)
+    result.figures.cached("fig5_load_sharing", fig_load_sharing, healthy)
     if case.stiffness.method == "fe":
         from ..stiffness.fe import plot_mesh
 
-        result.figures["fig_fe_mesh"] = plot_mesh(case, cracked=case.crack is not None
-                                                  and case.crack.active)
+        result.figures.cached("fig_fe_mesh", plot_mesh, case,
+                              cracked=case.crack is not None and case.crack.active)
     if case.crack is not None and case.crack.active:
-        result.figures["fig6_crack"] = fig_crack(healthy, cracked)
+        result.figures.cached("fig6_crack", fig_crack, healthy, cracked)
         dd_op = result.summary.get("static", {}).get("centre_distance_change_mm", 0.0) * 1e-3
         dd_op = dd_op if cracked.covers(dd_op) else 0.0
         result.summary["crack_angle_in_stiffness_deg"] = math.degrees(
@@ -303,20 +303,20 @@ def simulation_stage(case: Case, out: Path, result: StudyResult) -> None:
     tc = float(tcs[0]) if tcs.size else float(t[0] + 0.5 * (t[-1] - t[0]))
     half = 0.55 * rev
     w8 = (max(t[0], tc - half), min(t[-1], tc + half))
-    result.figures["fig8_design_parameters"] = pf.fig8_design_parameters(ds2, ca, w8)
+    result.figures.cached("fig8_design_parameters", pf.fig8_design_parameters, ds2, ca, w8)
     ds_s = runs[("II-start", "cracked")]
     ts = ds_s["time"].values
     tcs_s = pf.crack_times(ds_s, ca) if ca is not None else np.array([])
     tc_s = float(tcs_s[0]) if tcs_s.size else float(ts[0] + 0.5 * (ts[-1] - ts[0]))
     w9 = (max(ts[0], tc_s - 0.012), min(ts[-1], tc_s + 0.012))
-    result.figures["fig9_iteration"] = pf.fig9_iteration(ds_s, ds2, ca, w9,
-                                                         case.simulation.tolerance)
-    result.figures["fig10_stiffness"] = pf.fig10_stiffness(runs[("I", "cracked")], ds2, ca, w8,
-                                                           ds_i_static=runs[("I-static", "cracked")])
+    result.figures.cached("fig9_iteration", pf.fig9_iteration, ds_s, ds2, ca, w9,
+                          case.simulation.tolerance)
+    result.figures.cached("fig10_stiffness", pf.fig10_stiffness, runs[("I", "cracked")], ds2, ca,
+                          w8, ds_i_static=runs[("I-static", "cracked")])
     result.summary["model_comparison"] = model_comparison(runs)
     if result.summary["model_comparison"]:
-        result.figures["fig_model_comparison"] = pf.fig_model_comparison(
-            result.summary["model_comparison"])
+        result.figures.cached("fig_model_comparison", pf.fig_model_comparison,
+                              result.summary["model_comparison"])
 
 
 #: Share of the samples whose differences :func:`model_comparison` reports the energy of
@@ -520,16 +520,17 @@ def diagnostics_stage(case: Case, out: Path, result: StudyResult) -> None:
 
     # Figs. 11-23
     F = result.figures
-    F["fig11_tsa"] = pf.fig_tsa(cracked)
-    F["fig12_spectra"] = pf.fig_spectra(cracked, z)
-    F["fig13_residuals"] = pf.fig_residuals(cracked)
+    F.cached("fig11_tsa", pf.fig_tsa, cracked)
+    F.cached("fig12_spectra", pf.fig_spectra, cracked, z)
+    F.cached("fig13_residuals", pf.fig_residuals, cracked)
     max_order = 6 * z
-    F["fig14_pwvd_tsa_gear"] = pf.fig_pwvd_pair(cracked, "v_yg", "tsa", z, max_order)
+    F.cached("fig14_pwvd_tsa_gear", pf.fig_pwvd_pair, cracked, "v_yg", "tsa", z, max_order)
     numbers = {"v_yg": (15, 16, 17), "omega_p": (18, 19, 20), "transmission_error": (21, 22, 23)}
     for sig, (a, b, c) in numbers.items():
-        F[f"fig{a}_pwvd_residual_{sig}"] = pf.fig_pwvd_pair(cracked, sig, "residual", z, max_order)
-        F[f"fig{b}_demodulation_{sig}"] = pf.fig_demodulation_pair(cracked, sig)
-        F[f"fig{c}_analytic_{sig}"] = pf.fig_analytic_pair(cracked, sig)
+        F.cached(f"fig{a}_pwvd_residual_{sig}", pf.fig_pwvd_pair, cracked, sig, "residual", z,
+                 max_order)
+        F.cached(f"fig{b}_demodulation_{sig}", pf.fig_demodulation_pair, cracked, sig)
+        F.cached(f"fig{c}_analytic_{sig}", pf.fig_analytic_pair, cracked, sig)
     # the figures are rendered: drop the time-frequency distributions (tens of MB per signal and
     # run), which no later stage reads
     result.diagnoses = {k: _without_distributions(d) for k, d in diags.items()}
@@ -558,8 +559,8 @@ def measurement_stage(case: Case, out: Path, result: StudyResult) -> None:
     if "skipped" in m:
         result.notes.append(f"Realistic-measurement section skipped: {m['skipped']}.")
     elif result.measured_tsa:
-        result.figures["fig24_measured_tsa"] = pf.fig_measured_tsa(result.measured_tsa,
-                                                                   m["model"])
+        result.figures.cached("fig24_measured_tsa", pf.fig_measured_tsa, result.measured_tsa,
+                              m["model"])
 
 
 def _report_stage(case: Case, out: Path, result: StudyResult) -> None:

@@ -125,6 +125,76 @@ class RenderedFigure:
         fh.write(self.png)
 
 
+class _Undigestable(Exception):
+    """An argument the figure cache cannot fingerprint (the figure is then drawn, not cached)."""
+
+
+def _digest(obj, h) -> None:
+    """Feed a canonical fingerprint of ``obj`` to the hash ``h`` (arrays by dtype, shape and
+    bytes; dataclasses, mappings and sequences element by element; xarray objects by their
+    variables, coordinates and attributes)."""
+    import dataclasses
+
+    import numpy as np
+
+    if obj is None or isinstance(obj, (bool, int, float, complex, str, bytes)):
+        h.update(f"{type(obj).__name__}:{obj!r};".encode())
+    elif isinstance(obj, np.generic):
+        h.update(f"{obj.dtype}:{obj.item()!r};".encode())
+    elif isinstance(obj, np.ndarray):
+        if obj.dtype.hasobject:
+            raise _Undigestable(type(obj))
+        h.update(f"nd:{obj.dtype.str}:{obj.shape};".encode())
+        h.update(np.ascontiguousarray(obj).tobytes())
+    elif dataclasses.is_dataclass(obj) and not isinstance(obj, type):
+        h.update(f"dc:{type(obj).__module__}.{type(obj).__qualname__};".encode())
+        for f in dataclasses.fields(obj):
+            h.update(f.name.encode())
+            _digest(getattr(obj, f.name), h)
+    elif isinstance(obj, dict):
+        h.update(f"dict:{len(obj)};".encode())
+        for k in sorted(obj, key=repr):
+            _digest(k, h)
+            _digest(obj[k], h)
+    elif isinstance(obj, (list, tuple)):
+        h.update(f"{type(obj).__name__}:{len(obj)};".encode())
+        for x in obj:
+            _digest(x, h)
+    elif hasattr(obj, "model_dump") and hasattr(type(obj), "model_fields"):  # pydantic (Case)
+        h.update(f"pyd:{type(obj).__module__}.{type(obj).__qualname__};".encode())
+        _digest(obj.model_dump(mode="json"), h)
+    elif hasattr(obj, "variables") and hasattr(obj, "attrs"):  # xarray.Dataset
+        h.update(b"xr-dataset;")
+        for name in sorted(obj.variables):
+            v = obj.variables[name]
+            _digest((name, v.dims, dict(v.attrs)), h)
+            _digest(np.asarray(v.values), h)
+        _digest(dict(obj.attrs), h)
+    else:
+        raise _Undigestable(type(obj))
+
+
+def _source_digest() -> str:
+    """Hash of geardyn's Python sources and the plotting library's version: any change of the
+    code or of matplotlib invalidates every cached figure."""
+    global _SOURCE_DIGEST
+    if _SOURCE_DIGEST is None:
+        import hashlib
+
+        import matplotlib
+
+        h = hashlib.sha256(f"matplotlib {matplotlib.__version__}; dpi {FIGURE_DPI};".encode())
+        root = Path(__file__).resolve().parents[1]
+        for path in sorted(root.rglob("*.py")):
+            h.update(str(path.relative_to(root)).encode())
+            h.update(path.read_bytes())
+        _SOURCE_DIGEST = h.hexdigest()
+    return _SOURCE_DIGEST
+
+
+_SOURCE_DIGEST: str | None = None
+
+
 class FigureStore(dict):
     """Figure name -> :class:`RenderedFigure`: a matplotlib figure assigned is rendered to PNG
     (:data:`FIGURE_DPI`, tight bounding box, as the report embeds it) and closed, which keeps a
@@ -142,3 +212,31 @@ class FigureStore(dict):
             plt.close(fig)
             fig = RenderedFigure(buf.getvalue())
         super().__setitem__(key, fig)
+
+    def cached(self, key, draw: Callable, *args, **kwargs) -> None:
+        """``self[key] = draw(*args, **kwargs)``, through the disk cache (kind ``figure``): the
+        PNG is keyed by a fingerprint of the arguments (:func:`_digest`), ``draw``'s name and
+        geardyn's sources, so a run whose inputs did not change takes its figures from the
+        cache instead of drawing them again (issue 16.6). Arguments it cannot fingerprint, or
+        ``GEARDYN_NO_CACHE``, draw the figure as before."""
+        import hashlib
+
+        from ..cache import default_cache
+
+        h = hashlib.sha256(f"{key};{draw.__module__}.{draw.__qualname__};".encode())
+        try:
+            _digest(args, h)
+            _digest(kwargs, h)
+        except _Undigestable:
+            self[key] = draw(*args, **kwargs)
+            return
+        h.update(_source_digest().encode())
+
+        def build() -> bytes:
+            self[key] = draw(*args, **kwargs)
+            return dict.__getitem__(self, key).png
+
+        png, _ = default_cache().get_or_build("figure", h.hexdigest(), ".png", build,
+                                              lambda data, path: Path(path).write_bytes(data),
+                                              lambda path: Path(path).read_bytes())
+        super().__setitem__(key, RenderedFigure(png))
