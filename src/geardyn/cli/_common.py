@@ -92,11 +92,36 @@ def one_line(text: str, limit: int = MAX_ERROR_CHARS) -> str:
     return text if len(text) <= limit else text[: limit - 26] + " ... (message shortened)"
 
 
+#: Set by the Ctrl-C handler of :func:`handle_errors`. A KeyboardInterrupt raised while numba
+#: compiles is swallowed by llvmlite's ctypes callbacks ("Exception ignored on calling ctypes
+#: callback function"), so the command would run on to the end; the progress callbacks
+#: (:class:`StageProgress`) raise it again at their next tick.
+_INTERRUPT = {"pending": False}
+
+
+def _on_sigint(signum, frame) -> None:
+    _INTERRUPT["pending"] = True
+    raise KeyboardInterrupt
+
+
+def raise_pending_interrupt() -> None:
+    """Raise KeyboardInterrupt if a Ctrl-C arrived and was swallowed on the way."""
+    if _INTERRUPT["pending"]:
+        raise KeyboardInterrupt
+
+
 def handle_errors(fn: F) -> F:
     """Turn geardyn errors into one clear line and exit code 2 (130 on Ctrl-C)."""
 
     @functools.wraps(fn)
     def wrapper(*args: Any, **kwargs: Any) -> Any:
+        import signal
+        import threading
+
+        old = None
+        if threading.current_thread() is threading.main_thread():
+            _INTERRUPT["pending"] = False
+            old = signal.signal(signal.SIGINT, _on_sigint)
         try:
             return fn(*args, **kwargs)
         except typer.Exit:
@@ -119,6 +144,10 @@ def handle_errors(fn: F) -> F:
                               "geardyn; GEARDYN_DEBUG=1 shows the traceback)", highlight=False,
                               soft_wrap=True)
             raise typer.Exit(1) from None
+        finally:
+            if old is not None:
+                signal.signal(signal.SIGINT, old)
+            _INTERRUPT["pending"] = False
 
     return wrapper  # type: ignore[return-value]
 
@@ -205,6 +234,7 @@ class StageProgress:
         self.ready_file = os.environ.get("GEARDYN_TEST_READY_FILE")
 
     def __call__(self, stage: str, done: int = 0, total: int | None = None) -> None:
+        raise_pending_interrupt()
         key, _, item = str(stage).partition(": ")
         total = int(total) if total else 0
         announce = bool(self.stages) and not item and total == len(self.stages) and (
