@@ -127,7 +127,9 @@ def test_zero_size_faults_give_the_healthy_map(base, theta, healthy):
     m = _model(zero)
     assert set(m.influence) == {"pinion", "gear"} and len(m.bands) == 1 and not m.wear
     _same(m.evaluate(theta, 0.0), healthy)
-    _same(m.evaluate(theta, 0.0, compiled=False), healthy)
+    # the pure-Python reference against the compiled healthy map: the twins' tolerance (their
+    # hypot differs in the last bit on some builds, e.g. numpy 1.26 at the floors)
+    _same(m.evaluate(theta, 0.0, compiled=False), healthy, rtol=1e-9)
 
 
 # ------------------------------------------------------------------------ bands across the face
