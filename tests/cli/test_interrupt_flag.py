@@ -43,3 +43,30 @@ def test_a_swallowed_interrupt_is_raised_at_the_next_tick_and_exits_130():
     assert exc.value.exit_code == 130 and ticks == [0]
     assert C._INTERRUPT["pending"] is False          # cleared for the next command
     assert signal.getsignal(signal.SIGINT) is not C._on_sigint  # handler restored
+
+
+def test_an_interrupt_swallowed_by_a_ctypes_callback_prints_no_traceback(capsys):
+    """What llvmlite does while numba compiles: the KeyboardInterrupt is raised inside a ctypes
+    callback, which Python reports through sys.unraisablehook ("Exception ignored ..." and a
+    traceback) and otherwise drops."""
+    import ctypes
+
+    def callback():
+        raise KeyboardInterrupt
+
+    fn = ctypes.CFUNCTYPE(None)(callback)
+    ticks = []
+
+    @C.handle_errors
+    def command():
+        progress = C.StageProgress(_Bar())
+        fn()                          # swallowed by ctypes, reported to the hook
+        ticks.append("after the callback")
+        progress("model II", 1, 10)   # raised again here
+
+    with pytest.raises(typer.Exit) as exc:
+        command()
+    err = capsys.readouterr().err
+    assert exc.value.exit_code == 130 and ticks == ["after the callback"]
+    assert "Traceback" not in err and "Exception ignored" not in err
+    assert "interrupted" in err

@@ -104,6 +104,20 @@ def _on_sigint(signum, frame) -> None:
     raise KeyboardInterrupt
 
 
+def _unraisable(default):
+    """A :data:`sys.unraisablehook` that keeps a Ctrl-C swallowed by a callback (Python would
+    print "Exception ignored ..." and a traceback) as a pending interrupt, and passes every other
+    unraisable exception to ``default``."""
+
+    def hook(args) -> None:
+        if isinstance(args.exc_value, KeyboardInterrupt):
+            _INTERRUPT["pending"] = True
+            return
+        default(args)
+
+    return hook
+
+
 def raise_pending_interrupt() -> None:
     """Raise KeyboardInterrupt if a Ctrl-C arrived and was swallowed on the way."""
     if _INTERRUPT["pending"]:
@@ -119,9 +133,11 @@ def handle_errors(fn: F) -> F:
         import threading
 
         old = None
+        old_hook = sys.unraisablehook
         if threading.current_thread() is threading.main_thread():
             _INTERRUPT["pending"] = False
             old = signal.signal(signal.SIGINT, _on_sigint)
+            sys.unraisablehook = _unraisable(old_hook)
         try:
             return fn(*args, **kwargs)
         except typer.Exit:
@@ -147,6 +163,7 @@ def handle_errors(fn: F) -> F:
         finally:
             if old is not None:
                 signal.signal(signal.SIGINT, old)
+                sys.unraisablehook = old_hook
             _INTERRUPT["pending"] = False
 
     return wrapper  # type: ignore[return-value]
