@@ -107,10 +107,12 @@ def stiffness_stage(case: Case, out: Path, result: StudyResult) -> None:
 
     map_case = _map_case(case, result.quick)
     if map_case is not case:
-        result.notes.append("--quick: the stiffness maps are coarser than the case's (FE mesh "
-                            f"refinement {map_case.stiffness.fe.refinement:g}, "
-                            f"{map_case.stiffness.centre_distances} centre distances); "
-                            "run without --quick for the case's own maps.")
+        what = [f"{map_case.stiffness.centre_distances} centre distances"]
+        if map_case.stiffness.fe.refinement != case.stiffness.fe.refinement:
+            what.insert(0, f"FE mesh refinement {map_case.stiffness.fe.refinement:g}")
+        result.notes.append("--quick: the stiffness maps are coarser than the case's ("
+                            + ", ".join(what) + "); run without --quick for the case's own "
+                            "maps.")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the maps record their warnings in attrs (read below)
         healthy = _build_map_with_progress(build_map, map_case, False, result,

@@ -407,6 +407,25 @@ def _zero_small(x: float, tiny: float) -> float:
     return 0.0 if abs(x) <= tiny else x
 
 
+def _fault_word(case: Case) -> str:
+    """What the narrowband envelope's peak locates: "crack", "fault", "faults" or "" (a healthy
+    pair: the peak then locates nothing)."""
+    n = len(getattr(case, "faults", None) or ())
+    crack = case.crack is not None and case.crack.active
+    if n == 0:
+        return "crack" if crack else ""
+    return "faults" if n + crack > 1 else "fault"
+
+
+def _short_value(value) -> str:
+    """A changed input as the title shows it: a faults list as its types and places, other
+    values as they are."""
+    if isinstance(value, list) and value and all(isinstance(v, dict) for v in value):
+        return "[" + ", ".join(f"{v.get('type')} on {v.get('gear', 'pinion')} tooth "
+                               f"{v.get('tooth')}" for v in value) + "]"
+    return str(value)
+
+
 def _own_case_title(case: Case, diffs: list[dict]) -> tuple[str, str]:
     """Title and subtitle of the report of a case that is not the paper's.
 
@@ -418,7 +437,7 @@ def _own_case_title(case: Case, diffs: list[dict]) -> tuple[str, str]:
     ref = paper_case()
     name = f"'{case.name}'"
     if diffs:
-        shown = ", ".join(f"{d['key']} = {d['case']}" for d in diffs[:3])
+        shown = ", ".join(f"{d['key']} = {_short_value(d['case'])}" for d in diffs[:3])
         name += f": {shown}" + (f" and {len(diffs) - 3} more changes" if len(diffs) > 3 else "")
     desc = case.description
     if desc.startswith(ref.description):  # inherited; keep only what was added (e.g. "[changed
@@ -489,8 +508,9 @@ def report_stage(case: Case, out: Path, result: StudyResult) -> None:
             f"pressure angle is {s.get('operating_pressure_angle_deg', float('nan')):.3f} deg and "
             f"the contact ratio {cr.get('physical', float('nan')):.4f} "
             f"({cr.get('paper_eq8', float('nan')):.4f} by eq. 8 of Xue & Howard)."
-            + (f" The crack shows at about {s.get('crack_angle_deg'):.0f} deg of pinion "
-               "rotation." if s.get("crack_angle_deg") is not None else "")
+            + (f" The {_fault_word(case)} shows at about {s.get('crack_angle_deg'):.0f} deg of "
+               "pinion rotation (the peak of the narrowband envelope)."
+               if s.get("crack_angle_deg") is not None and _fault_word(case) else "")
             + f" {n_check} of {len(checks)} consistency checks pass.")
     if result.quick:
         rep.note("This is a --quick run: shorter records (fewer revolutions averaged). Run "
