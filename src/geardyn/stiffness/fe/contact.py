@@ -129,11 +129,19 @@ def candidates(pair, theta: float, dd: float, margin: float = 0.35) -> Candidate
     cp = pair.contact_points(theta, dd, margin=margin)
     op = pair.operating(dd, check=False)
     rb1, rb2 = pair.pinion.base_radius, pair.gear.base_radius
+    kind, u1, u2, gap, arm, radius = _contact_geometry(
+        cp.s, op, rb1, rb2, np.array([rb1 + rb2, op.t1t2]),
+        math.sqrt(pair.pinion.tip_radius ** 2 - rb1 ** 2),
+        math.sqrt(pair.gear.tip_radius ** 2 - rb2 ** 2))
+    return Candidates(pair=cp.pair, pinion_tooth=cp.pinion_tooth, gear_tooth=cp.gear_tooth,
+                      s=cp.s, kind=kind, u1=u1, u2=u2, gap=gap, arm=arm, radius=radius)
+
+
+def _contact_geometry(s, op, rb1, rb2, o2, ua1, ua2):
+    """Kind, roll lengths ``u1``, ``u2`` [m], gap [m], lever arm [m] and relative radius of
+    curvature [m] of contacts at LOA positions ``s`` [m] (a tip corner in extended contact
+    beyond the path: its gap to the mating flank and the contact there)."""
     t1t2 = op.t1t2
-    o2 = np.array([rb1 + rb2, t1t2])
-    ua1 = math.sqrt(pair.pinion.tip_radius ** 2 - rb1 ** 2)
-    ua2 = math.sqrt(pair.gear.tip_radius ** 2 - rb2 ** 2)
-    s = cp.s
     n = s.size
     kind = np.where(s > op.s_end, PINION_TIP, np.where(s < op.s_start, GEAR_TIP, PATH))
     u1 = s.copy()
@@ -170,9 +178,7 @@ def candidates(pair, theta: float, dd: float, margin: float = 0.35) -> Candidate
             u2[k] = ua2
     rho1 = np.clip(u1, 1e-9, None)
     rho2 = np.clip(u2, 1e-9, None)
-    return Candidates(pair=cp.pair, pinion_tooth=cp.pinion_tooth, gear_tooth=cp.gear_tooth, s=s,
-                      kind=kind, u1=u1, u2=u2, gap=gap, arm=arm,
-                      radius=rho1 * rho2 / (rho1 + rho2))
+    return kind, u1, u2, gap, arm, rho1 * rho2 / (rho1 + rho2)
 
 
 class CandidateGenerator:
@@ -258,47 +264,10 @@ class CandidateGenerator:
 
     def complete(self, n: np.ndarray, s: np.ndarray) -> Candidates:
         """Candidates of the pairs ``n`` at LOA positions ``s`` [m] (from :meth:`pairs`)."""
-        op, rb1, rb2, t1t2, o2 = self.op, self.rb1, self.rb2, self.t1t2, self.o2
-        ua1, ua2 = self.ua1, self.ua2
-        size = s.size
-        kind = np.where(s > op.s_end, PINION_TIP, np.where(s < op.s_start, GEAR_TIP, PATH))
-        u1 = s.copy()
-        u2 = t1t2 - s
-        gap = np.zeros(size)
-        arm = np.full(size, rb1)
-        for k in range(size):
-            if kind[k] == PINION_TIP:
-                beta = (s[k] - ua1) / rb1
-                c = rb1 * np.array([math.cos(beta), math.sin(beta)]) \
-                    + ua1 * np.array([-math.sin(beta), math.cos(beta)])
-                v = c - o2
-                r = math.hypot(*v)
-                gam = math.atan2(v[1], v[0]) - math.acos(rb2 / r)
-                lam = math.sqrt(r * r - rb2 * rb2)
-                g = lam + rb2 * float(_wrap(gam - math.pi)) - (t1t2 - s[k])
-                gap[k] = g
-                u1[k] = ua1
-                u2[k] = lam - g
-                t2 = o2 + rb2 * np.array([math.cos(gam), math.sin(gam)])
-                e = np.array([-math.sin(gam), math.cos(gam)])
-                arm[k] = abs(t2[0] * e[1] - t2[1] * e[0])
-            elif kind[k] == GEAR_TIP:
-                gn = t1t2 - s[k]
-                gam = math.pi + (gn - ua2) / rb2
-                c = o2 + rb2 * np.array([math.cos(gam), math.sin(gam)]) \
-                    + ua2 * np.array([-math.sin(gam), math.cos(gam)])
-                r = math.hypot(*c)
-                beta = math.atan2(c[1], c[0]) - math.acos(rb1 / r)
-                lam = math.sqrt(r * r - rb1 * rb1)
-                g = lam + rb1 * float(_wrap(beta)) - s[k]
-                gap[k] = g
-                u1[k] = lam - g
-                u2[k] = ua2
-        rho1 = np.clip(u1, 1e-9, None)
-        rho2 = np.clip(u2, 1e-9, None)
+        kind, u1, u2, gap, arm, radius = _contact_geometry(
+            s, self.op, self.rb1, self.rb2, self.o2, self.ua1, self.ua2)
         return Candidates(pair=n, pinion_tooth=np.mod(n, self.z1), gear_tooth=np.mod(n, self.z2),
-                          s=s, kind=kind, u1=u1, u2=u2, gap=gap, arm=arm,
-                          radius=rho1 * rho2 / (rho1 + rho2))
+                          s=s, kind=kind, u1=u1, u2=u2, gap=gap, arm=arm, radius=radius)
 
 
 class BodyCompliance:
