@@ -147,6 +147,14 @@ class GearConfig(_Model):
         None, ge=0, description="Bearing damping [N s/m]; omit to use bearing_damping_ratio.")
     bearing_damping_ratio: float = Field(0.05, ge=0, lt=1,
                                          description="Damping ratio of the bearing mode [-].")
+    bearing_stiffness_x: Stiffness | None = Field(
+        None, gt=0, description="Bearing stiffness across the line of action [N/m] (the "
+                                "transverse model, simulation.dynamics = 'transverse'); omit "
+                                "for isotropic bearings (= bearing_stiffness).")
+    bearing_damping_x: Damping | None = Field(
+        None, ge=0, description="Bearing damping across the line of action [N s/m] (transverse "
+                                "model); omit: bearing_damping for isotropic bearings, else "
+                                "from bearing_damping_ratio and bearing_stiffness_x.")
     torsional_damping: TorsionalDamping = Field(
         0.0, ge=0, description="Absolute torsional damping q_st (drag on absolute speed) "
                                "[N m s/rad].")
@@ -246,6 +254,10 @@ class MeshConfig(_Model):
                                                              "use damping_ratio.")
     damping_ratio: float = Field(0.07, ge=0, lt=1, description="Mesh damping ratio with the "
                                                                 "equivalent mass [-].")
+    friction_coefficient: float = Field(
+        0.0, ge=0, le=0.5, description="Coulomb coefficient of sliding friction between the "
+                                       "teeth [-] (the transverse model, simulation.dynamics = "
+                                       "'transverse'; typical lubricated steel 0.03-0.1).")
 
 
 class CrackConfig(_Model):
@@ -362,6 +374,11 @@ class SimulationConfig(_Model):
         "II", description="Model I: K(theta) at the design centre distance; I-static: K(theta) at "
                           "the static operating centre distance (eq. 4), held fixed; model II: "
                           "K(theta, d(t)).")
+    dynamics: Literal["6-dof", "transverse"] = Field(
+        "6-dof", description="'6-dof': the paper's model, centres moving along the line of "
+                             "action only; 'transverse': x and y for each centre, the mesh "
+                             "force along the operating line of action that turns with the "
+                             "centres, and sliding friction (mesh.friction_coefficient).")
     dt: Time = Field(1e-5, gt=0, description="Time step [s].")
     settle_time: Time = Field(0.5, ge=0, description="Simulated time discarded before recording "
                                                      "[s].")

@@ -477,6 +477,15 @@ def simulate(case, stiffness_map: StiffnessMap | None = None, *, model: str | No
     which = case.simulation.model if model is None else model
     if which not in MODELS:
         raise InputError("model", which, ", ".join(repr(m) for m in MODELS))
+    if case.simulation.dynamics == "transverse":
+        from .transverse import simulate_transverse
+
+        return simulate_transverse(case, stiffness_map, model=which, cracked=cracked,
+                                   progress=progress)
+    if case.mesh.friction_coefficient > 0:
+        raise InputError("mesh.friction_coefficient", case.mesh.friction_coefficient,
+                         "0 with simulation.dynamics = '6-dof' (friction acts across the line "
+                         "of action: set simulation.dynamics = 'transverse')")
     check_bounded_work(case)  # before any map, matrix or step: refuse runs that would not end
     if stiffness_map is None:
         from ..stiffness import build_map
