@@ -20,7 +20,8 @@ every term):
 * sliding friction: the generalised mesh force is ``-N b_c`` with ``b_c = g_c - f_c``, ``f_c``
   the friction directions per unit normal load (``mu`` times the load-share weighted, signed
   moment arms ``s_k``, ``tau - s_k`` and the normal ``n``); the sign of each pair is
-  ``sign(s_pitch - s_k)``, averaged over the step's roll like the stiffness window;
+  ``sign(s_pitch - s_k)``; the terms are averaged over the step's roll like the stiffness window
+  (split where a pair enters or leaves contact or crosses the pitch point);
 * the rank-one update with two vectors: ``u_c = S^-1 b_c``, ``sigma = g_c^T u_c``,
   ``N = (k p~ + q p~' + c g_c^T w) / (1 + c sigma)``, ``a = w - N u_c``;
 * iteration until the geometry is consistent: ``|phi(z_{n+1}) - phi_c| T1T2 < tol`` and the
@@ -30,10 +31,11 @@ With the centres held on the line of action (``x`` fixed, ``XFREE = 0``) and no 
 ``phi = 0``, ``g_c = g`` and ``u_c = u`` are constants and every operation is the 6-DOF kernel's:
 the paper's model is the special case (``tests/dynamics/test_transverse.py``).
 
-The twin :func:`advance_transverse_python` is written separately: it assembles the full effective
-matrix ``S + c b_c g_c^T`` and calls :func:`numpy.linalg.solve` (module ``_transverse_twin``), reads the map with
-:func:`geardyn.stiffness.map.lookup_reference` and the geometry with the NumPy functions of
-:mod:`geardyn.dynamics.transverse`.
+The twin ``advance_transverse_python`` (module ``_transverse_twin``) is written separately: it
+assembles the full effective matrix ``S + c b_c g_c^T`` and calls :func:`numpy.linalg.solve`,
+reads the map with :func:`geardyn.stiffness.map.lookup_reference` and the geometry with the NumPy
+functions of :mod:`geardyn.dynamics.transverse`, and averages the friction over the step's roll
+with its own search of the events.
 """
 
 from __future__ import annotations
@@ -91,23 +93,20 @@ def _geometry(z, tip, rsum, t1t2):
 
 
 @numba.njit(cache=True, nogil=True, fastmath=False)
-def _friction(th, hs, tau, dd, tfp, tip, dd0, ddd, phase_a, length_a, mesh_angle, n_cycles,
-              n_seg, kvals, els):
-    """Friction per unit normal load: ``(m_f, A_1, A_2)``.
+def _friction_point(sx, tau, dd, tfp, tip, dd0, ddd, phase_a, length_a, mesh_angle, n_cycles,
+                    n_seg, kvals, els):
+    """Friction per unit normal load at the roll position ``sx = s_pitch0 + r_b1 theta`` of the
+    map angle ``theta``: ``(m_f, A_1, A_2)``.
 
     ``m_f = mu sum w_k sg_k`` (force along the normal ``n`` on the gear, minus on the pinion),
-    ``A_1 = mu sum w_k sg_k s_k`` and ``A_2 = mu sum w_k sg_k (tau - s_k)`` [m] (moment arms of
-    the pinion and the gear), over the slots in contact at map angle ``th``; ``w_k`` the map's
-    load shares scaled to sum 1 (equal shares without them), ``sg_k`` the sign of
-    ``s_pitch - s_k`` averaged over ``[s_k - hs, s_k + hs]`` (``hs`` half the step's roll [m]).
+    ``A_1 = mu sum w_k sg_k s_k`` and ``A_2 = mu sum w_k sg_k (tau - s_k)`` [m] (moments on the
+    pinion and, against its rotation, the gear) over the slots in contact; ``w_k`` the map's
+    load shares scaled to sum 1 (equal shares without them), ``sg_k = sign(s_pitch - s_k)``.
     """
-    mu = tfp[TF_MU]
-    if mu == 0.0:
-        return 0.0, 0.0, 0.0
     rb1 = tfp[TF_RB1]
     pb = tfp[TF_PB]
-    s_th = tfp[TF_PITCH_S] + rb1 * th
-    n_exit = math.floor((s_th - tfp[TF_S_END]) / pb)
+    th = (sx - tfp[TF_PITCH_S]) / rb1
+    n_exit = math.floor((sx - tfp[TF_S_END]) / pb)
     s_start = tau - tfp[TF_U2TIP]
     s_pitch = tau * rb1 / (rb1 + tfp[TF_RB2])
     sh0 = sh1 = sh2 = 1.0
@@ -119,25 +118,77 @@ def _friction(th, hs, tau, dd, tfp, tip, dd0, ddd, phase_a, length_a, mesh_angle
     a1 = 0.0
     a2 = 0.0
     for k in range(3):
-        s = s_th - (n_exit + 1 + k) * pb
+        s = sx - (n_exit + 1 + k) * pb
         if s < s_start - 1e-12:
             continue
         sh = sh0 if k == 0 else (sh1 if k == 1 else sh2)
-        if hs > 0.0:
-            sg = (s_pitch - s) / hs
-            if sg > 1.0:
-                sg = 1.0
-            elif sg < -1.0:
-                sg = -1.0
-        else:
-            sg = 1.0 if s < s_pitch else (-1.0 if s > s_pitch else 0.0)
+        sg = 1.0 if s < s_pitch else (-1.0 if s > s_pitch else 0.0)
         tot += sh
         mf += sh * sg
         a1 += sh * sg * s
         a2 += sh * sg * (tau - s)
     if not tot > 0.0:
         return 0.0, 0.0, 0.0
+    mu = tfp[TF_MU]
     return mu * mf / tot, mu * a1 / tot, mu * a2 / tot
+
+
+@numba.njit(cache=True, nogil=True, fastmath=False)
+def _friction(th, hs, tau, dd, tfp, tip, dd0, ddd, phase_a, length_a, mesh_angle, n_cycles,
+              n_seg, kvals, els):
+    """Friction per unit normal load ``(m_f, A_1, A_2)`` at map angle ``th``, averaged over the
+    step's roll ``[s - hs, s + hs]`` (``hs`` [m]; 0: the point value).
+
+    The terms jump where a pair enters (``s_k = s_start``) or leaves (``s_k = s_end``) contact and
+    where it crosses the pitch point (the sign). The window is split at those events (at most
+    one of each kind: the window is far shorter than a base pitch) and each part evaluated at its
+    midpoint, weighted by its length: exact for the piecewise-linear terms, as
+    :func:`geardyn.stiffness.map.lookup_box` is for the stiffness, so the scheme keeps order 2.
+    Without an event inside the window the point value is returned.
+    """
+    if tfp[TF_MU] == 0.0:
+        return 0.0, 0.0, 0.0
+    rb1 = tfp[TF_RB1]
+    pb = tfp[TF_PB]
+    sx = tfp[TF_PITCH_S] + rb1 * th
+    if not hs > 0.0:
+        return _friction_point(sx, tau, dd, tfp, tip, dd0, ddd, phase_a, length_a, mesh_angle,
+                               n_cycles, n_seg, kvals, els)
+    ev0 = tau - tfp[TF_U2TIP]
+    ev1 = tfp[TF_S_END]
+    ev2 = tau * rb1 / (rb1 + tfp[TF_RB2])
+    br = np.empty(3)
+    nb = 0
+    for c in (ev0, ev1, ev2):
+        # offset delta in (-hs, hs) with sx + delta = c + m pb for an integer m
+        dl = (c - sx + hs) % pb - hs
+        if -hs < dl < hs:
+            br[nb] = dl
+            nb += 1
+    if nb == 0:
+        return _friction_point(sx, tau, dd, tfp, tip, dd0, ddd, phase_a, length_a, mesh_angle,
+                               n_cycles, n_seg, kvals, els)
+    for i in range(nb):  # sort the breakpoints
+        for k in range(i + 1, nb):
+            if br[k] < br[i]:
+                t = br[i]
+                br[i] = br[k]
+                br[k] = t
+    mf = 0.0
+    a1 = 0.0
+    a2 = 0.0
+    lo = -hs
+    for i in range(nb + 1):
+        hi = br[i] if i < nb else hs
+        if hi > lo:
+            m, p1, p2 = _friction_point(sx + 0.5 * (lo + hi), tau, dd, tfp, tip, dd0, ddd,
+                                        phase_a, length_a, mesh_angle, n_cycles, n_seg, kvals,
+                                        els)
+            mf += (hi - lo) * m
+            a1 += (hi - lo) * p1
+            a2 += (hi - lo) * p2
+        lo = hi
+    return mf / (2.0 * hs), a1 / (2.0 * hs), a2 / (2.0 * hs)
 
 
 @numba.njit(cache=True, nogil=True, fastmath=False)

@@ -87,19 +87,36 @@ def advance_transverse_python(n_steps, rec_start, decim, out, j, st, ist, fail,
                                   fp[K.FP_OUT_P2], out_w, out_t, w0 + dz)
                  - fp[K.FP_OUT_TREF] - fp[K.FP_OUT_SLOPE] * dz)
 
-    def friction(th, hwin, tau, dd):
-        if mu == 0.0:
-            return 0.0, 0.0, 0.0
-        s_th = tfp[T.TF_PITCH_S] + rb1 * th
-        n_exit = math.floor((s_th - tfp[T.TF_S_END]) / pb)
-        s = s_th - (n_exit + 1 + np.arange(3)) * pb
+    def friction_point(sx, tau, dd):
+        th = (sx - tfp[T.TF_PITCH_S]) / rb1
+        n_exit = math.floor((sx - tfp[T.TF_S_END]) / pb)
+        s = sx - (n_exit + 1 + np.arange(3)) * pb
         inc = s >= tau - tfp[T.TF_U2TIP] - 1e-12
         if share_maps is not None:
             sh = np.array([float(lookup_reference(np.array(th), np.array(dd), m))
                            for m in share_maps])
         else:
             sh = np.ones(3)
-        return friction_terms(s[inc], sh[inc], tau, rb1, rb2, mu, hwin)
+        return np.array(friction_terms(s[inc], sh[inc], tau, rb1, rb2, mu))
+
+    def friction(th, hwin, tau, dd):
+        """Window average: the events (entry, exit, pitch point) of every pair within reach
+        split the window; each part's midpoint value weighted by its length."""
+        if mu == 0.0:
+            return 0.0, 0.0, 0.0
+        sx = tfp[T.TF_PITCH_S] + rb1 * th
+        if not hwin > 0.0:
+            return tuple(friction_point(sx, tau, dd))
+        events = np.array([tau - tfp[T.TF_U2TIP], tfp[T.TF_S_END], tau * rb1 / (rb1 + rb2)])
+        m = np.arange(-200, 201)[:, None]
+        cand = (events[None, :] + m * pb - sx).ravel()
+        cuts = np.sort(cand[(cand > -hwin) & (cand < hwin)])
+        edges = np.concatenate([[-hwin], cuts, [hwin]])
+        if cuts.size == 0:
+            return tuple(friction_point(sx, tau, dd))
+        acc = sum((hi - lo) * friction_point(sx + 0.5 * (lo + hi), tau, dd)
+                  for lo, hi in zip(edges[:-1], edges[1:], strict=True) if hi > lo)
+        return tuple(acc / (2.0 * hwin))
 
     def write(jj):
         out[jj, :nd], out[jj, nd:2 * nd] = st[:nd], st[s_v:s_v + nd]

@@ -44,8 +44,13 @@ along ``n`` (``omega_g`` positive in the driven direction), zero at the pitch po
 s_k)`` (the sign changes at the pitch point; the position decides it, not the velocity, so that a
 slow or stopped gear does not chatter), with the moments ``+mu N_k sg_k s_k`` on the pinion and
 ``-mu N_k sg_k (tau - s_k)`` on the gear (in the driven direction). ``N_k = w_k N`` shares the
-normal load by the map's load shares (equal shares when the map has none). Its power is
-``-mu N_k |v_s|`` at the steady speeds: it always dissipates. The off-line-of-action force
+normal load by the map's load shares (equal shares when the map has none). In each time step the
+terms are averaged over the step's roll, split where a pair enters or leaves contact or crosses
+the pitch point, as the stiffness is (the scheme keeps order 2). Its power is ``-mu N_k |v_s|``
+at the steady speeds: it dissipates. When the centres vibrate across the line of action, their
+velocity adds to ``v_s``; near the pitch point, where the rolling part is small, the
+position-decided sign can then make the friction do positive work (a velocity-decided,
+regularised Coulomb law would not; it is not built). The off-line-of-action force
 ``mu N sum w_k sg_k`` loads the bearings across the line of action, where only this model has a
 degree of freedom.
 
@@ -120,8 +125,8 @@ def mesh_deflection(theta_p, theta_g, x_p, y_p, x_g, y_g, r_b1: float, r_b2: flo
         - rsum * phi - tau + t1t2
 
 
-def friction_terms(s, shares, tau: float, r_b1: float, r_b2: float, mu: float,
-                   half_window: float = 0.0) -> tuple[float, float, float]:
+def friction_terms(s, shares, tau: float, r_b1: float, r_b2: float, mu: float
+                   ) -> tuple[float, float, float]:
     """Friction per unit normal load ``(m_f, A_1, A_2)`` of the pairs at roll lengths ``s``.
 
     Parameters
@@ -136,14 +141,12 @@ def friction_terms(s, shares, tau: float, r_b1: float, r_b2: float, mu: float,
         Base radii [m].
     mu : float
         Coefficient of friction [-].
-    half_window : float
-        Half the roll of the time step [m]: the sign is averaged over ``[s - h, s + h]``
-        (0: the point value).
 
     Returns
     -------
     m_f : float
-        ``mu sum w_k sg_k``: the friction force on the gear along ``n`` per unit ``N`` [-].
+        ``mu sum w_k sg_k``: the friction force on the gear along ``n`` per unit ``N`` [-],
+        ``sg_k = sign(s_pitch - s_k)``.
     A_1, A_2 : float
         ``mu sum w_k sg_k s_k`` and ``mu sum w_k sg_k (tau - s_k)``: friction moments on the
         pinion and (against the driven direction) the gear per unit ``N`` [m].
@@ -153,11 +156,7 @@ def friction_terms(s, shares, tau: float, r_b1: float, r_b2: float, mu: float,
     if mu == 0.0 or s.size == 0 or not w.sum() > 0:
         return 0.0, 0.0, 0.0
     w = w / w.sum()
-    s_pitch = tau * r_b1 / (r_b1 + r_b2)
-    if half_window > 0:
-        sg = np.clip((s_pitch - s) / half_window, -1.0, 1.0)
-    else:
-        sg = np.sign(s_pitch - s)
+    sg = np.sign(tau * r_b1 / (r_b1 + r_b2) - s)
     return (float(mu * np.sum(w * sg)), float(mu * np.sum(w * sg * s)),
             float(mu * np.sum(w * sg * (tau - s))))
 
