@@ -330,12 +330,27 @@ class FEConfig(_Model):
                               "paper's FEA) or 'tangent' dT / dtheta there (central difference "
                               "at T (1 +/- 0.05)), the incremental stiffness of small "
                               "fluctuations about the mean load.")
+    torques: list[Torque] | None = Field(
+        None, description="K(theta, d, F): FE maps at these pinion torques [N m] (at least two, "
+                          "increasing, bracketing the operating torque); the dynamics read the "
+                          "stiffness at each step's elastic mesh force, interpolated linearly "
+                          "between them. Omit for one map at `torque`.")
     plane: Literal["strain", "stress"] = Field("strain", description="Plane strain or stress.")
     mesh_size: Length | None = Field(None, gt=0, description="Element size in the tooth zone "
                                                               "[m]; omit for the default.")
     refinement: float = Field(1.0, gt=0, le=16, description="Mesh refinement factor [-] "
                                                             "(1 = default, 2 = twice as fine).")
     teeth_in_model: int = Field(5, ge=3, strict=True, description="Teeth in each body sector.")
+
+    @model_validator(mode="after")
+    def _torques(self) -> FEConfig:
+        t = self.torques
+        if t is not None and (len(t) < 2 or any(b <= a for a, b in zip(t[:-1], t[1:],
+                                                                         strict=True))
+                              or any(not v > 0 for v in t)):
+            raise ValueError(f"stiffness.fe.torques = {t}: give at least two increasing "
+                             "torques > 0 [N m], or omit it for one map")
+        return self
 
 
 class StiffnessConfig(_Model):

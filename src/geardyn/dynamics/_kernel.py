@@ -91,7 +91,8 @@ import numpy as np
 
 from ..stiffness.map import lookup_box, lookup_box_reference
 
-__all__ = ["advance", "advance_python", "law_torque", "STATUS_TEXT", "N_STATE", "N_FP", "N_IP",
+__all__ = ["advance", "advance_python", "law_torque", "family_lookup", "no_family", "STATUS_TEXT",
+           "N_STATE", "N_FP", "N_IP",
            "N_REC", "N_FAIL", "N_EIP", "N_EFP", "no_excitation"]
 
 # float parameters
@@ -111,7 +112,8 @@ N_IP = 9
 S_Z, S_V, S_A = 0, 6, 12
 S_N, S_K, S_H, S_DD, S_IT, S_RB, S_RA, S_QIN, S_QOUT = 18, 19, 20, 21, 22, 23, 24, 25, 26
 S_E, S_RIP = 27, 28
-N_STATE = 29
+S_FEL = 29  # elastic mesh force of the step: the load a K(theta, d, F) family is read at
+N_STATE = 30
 # record columns
 R_Z, R_V, R_N, R_DD, R_K, R_H, R_IT, R_RB, R_RA, R_E = 0, 6, 12, 13, 14, 15, 16, 17, 18, 19
 N_REC = 20
@@ -199,6 +201,11 @@ def _input_forcing(fp, n, sp_t, sp_w):
         wt = law_torque(3, 0.0, 0.0, 0.0, sp_t, sp_w, n * fp[FP_DT])
         out += fp[FP_DRIVE_GAIN] * (wt - fp[FP_WREF])
     return out
+
+
+def no_family():
+    """Load-family arrays of a single map (the kernel reads ``kvals`` only)."""
+    return (np.zeros(0), np.zeros((1, 1)), np.zeros((1, 1)), np.zeros((1, 1, 1)))
 
 
 def no_excitation():
@@ -365,10 +372,72 @@ def _excite(th, tha, b1, rsum, dd, pfree, sep, eip, efp, etp, etg, els,
 
 
 @numba.njit(cache=True, nogil=True, fastmath=False)
+def family_lookup(theta, h, dd, force, dd0, ddd, mesh_angle, n_cycles, n_seg, lf_force,
+                  lf_phase, lf_length, lf_vals):
+    """``K(theta, d, F)`` from maps at the loads ``lf_force`` [N] (increasing): the window
+    average :func:`geardyn.stiffness.map.lookup_box` of the two maps bracketing ``force``,
+    interpolated linearly in ``force``, constant beyond the ends [N/m]."""
+    nfm = lf_force.shape[0]
+    if force <= lf_force[0]:
+        i = 0
+        w = 0.0
+    elif force >= lf_force[nfm - 1]:
+        i = nfm - 2
+        w = 1.0
+    else:
+        i = 0
+        while i < nfm - 2 and force >= lf_force[i + 1]:
+            i += 1
+        w = (force - lf_force[i]) / (lf_force[i + 1] - lf_force[i])
+    k0 = lookup_box(theta, h, dd, dd0, ddd, lf_phase[i], lf_length[i], mesh_angle, n_cycles,
+                    n_seg, lf_vals[i])
+    if w == 0.0:
+        return k0
+    k1 = lookup_box(theta, h, dd, dd0, ddd, lf_phase[i + 1], lf_length[i + 1], mesh_angle,
+                    n_cycles, n_seg, lf_vals[i + 1])
+    if w == 1.0:
+        return k1
+    return k0 + w * (k1 - k0)
+
+
+@numba.njit(cache=True, nogil=True, fastmath=False)
+def _consistent_k(th, h, dd, fel0, frac, hh, pt, pdt, gw, ebar, q, bdt2, gdt, opa, sigma, rtol,
+                  dd0, ddd, mesh_angle, n_cycles, n_seg, lf_force, lf_phase, lf_length, lf_vals):
+    """The stiffness ``k`` with ``k = K(theta, d, F(k))``, ``F(k)`` the elastic mesh force the
+    step's solve gives with ``k`` (a scalar function through the Sherman-Morrison update:
+    ``N(k)`` and ``p(k) = p~ + beta dt^2 (g^T w - (1+alpha) N sigma)``), by the secant method
+    from ``K`` at the load ``fel0``; to ``rtol`` of ``k`` (at most 50 steps)."""
+    k = family_lookup(th, h, dd, fel0, dd0, ddd, mesh_angle, n_cycles, n_seg, lf_force,
+                      lf_phase, lf_length, lf_vals)
+    k_prev = np.nan
+    r_prev = np.nan
+    for _ in range(50):
+        keff = k * frac
+        nf = 0.0
+        if hh > 0.0:
+            c = bdt2 * keff + gdt * q
+            nf = (keff * (pt - ebar) + q * pdt + c * gw) / (1.0 + opa * c * sigma)
+        pn = pt + bdt2 * (gw - opa * nf * sigma)
+        fel = hh * keff * (pn - ebar)
+        r = family_lookup(th, h, dd, fel, dd0, ddd, mesh_angle, n_cycles, n_seg, lf_force,
+                          lf_phase, lf_length, lf_vals) - k
+        if abs(r) <= rtol * abs(k):
+            return k
+        k_next = k + r
+        if k_prev == k_prev and r != r_prev:
+            k_next = k - r * (k - k_prev) / (r - r_prev)
+        k_prev = k
+        r_prev = r
+        k = k_next
+    return k
+
+
+@numba.njit(cache=True, nogil=True, fastmath=False)
 def advance(n_steps, rec_start, decim, out, j, st, ist, fail,
             M, K0, C, Q0, Sinv, SK, SC, sQ, u, g, fp, ip,
             dd0, ddd, phase_a, length_a, mesh_angle, n_cycles, n_seg, kvals,
-            in_w, in_t, out_w, out_t, eip, efp, etp, etg, els, sp_t, sp_w):
+            in_w, in_t, out_w, out_t, eip, efp, etp, etg, els, sp_t, sp_w,
+            lf_force, lf_phase, lf_length, lf_vals):
     """Advance the state ``st`` (step count ``ist[0]``) by up to ``n_steps`` steps.
 
     Writes a record row into ``out[j]`` after every step ``n >= rec_start`` with
@@ -413,6 +482,7 @@ def advance(n_steps, rec_start, decim, out, j, st, ist, fail,
     hper = efp[EF_HPER]
     rip = fp[FP_RIP_AMP] != 0.0 or fp[FP_DRIVE_GAIN] != 0.0
     dtr = 0.0
+    fam = lf_force.shape[0] >= 2  # K(theta, d, F): maps at several loads
 
     xt = np.empty(6)
     vt = np.empty(6)
@@ -514,8 +584,14 @@ def advance(n_steps, rec_start, decim, out, j, st, ist, fail,
         k_m1 = 0.0
         take_next = False
         status = OK
+        fel = st[S_FEL]  # the load the family is read at: first the last step's
+        fel_new = fel
         while True:
-            if it == 0 and k_pre == k_pre and hbox <= 0.0:  # found with the shares there
+            if fam:
+                kk = _consistent_k(th_k, hbox, b1 - d0, fel, frac, hh, pt, pdt, gw, ebar, q,
+                                   bdt2, gdt, opa, sigma, rtol, dd0, ddd, mesh_angle, n_cycles,
+                                   n_seg, lf_force, lf_phase, lf_length, lf_vals)
+            elif it == 0 and k_pre == k_pre and hbox <= 0.0:  # found with the shares there
                 kk = k_pre
             else:
                 kk = lookup_box(th_k, hbox, b1 - d0, dd0, ddd, phase_a, length_a, mesh_angle,
@@ -536,6 +612,15 @@ def advance(n_steps, rec_start, decim, out, j, st, ist, fail,
             e = t1t2 + (xt[3] + bdt2 * an[3]) - (xt[1] + bdt2 * an[1])
             b2 = math.sqrt(rsum * rsum + e * e)
             conv = True
+            if fam:  # the stiffness at the load of this solve: iterate until it is consistent
+                pn = 0.0
+                for i in range(6):
+                    pn += g[i] * (xt[i] + bdt2 * an[i])
+                fel_new = hh * keff * (pn - ebar)
+                k_new = family_lookup(th_k, hbox, b1 - d0, fel_new, dd0, ddd, mesh_angle,
+                                      n_cycles, n_seg, lf_force, lf_phase, lf_length, lf_vals)
+                if abs(k_new - kk) > rtol * abs(kk):
+                    conv = False
             if model2:
                 res = abs(b1 - b2)
                 if it == 0:
@@ -589,6 +674,7 @@ def advance(n_steps, rec_start, decim, out, j, st, ist, fail,
             k_m1 = kk
             if model2:
                 b1 = b2
+            fel = fel_new
             it += 1
         if status != OK:
             _fail(fail, (n + 1) * dt, th, pt + bdt2 * gw, xt[1], xt[3], b1 - d0, nf, kk, it,
@@ -604,6 +690,8 @@ def advance(n_steps, rec_start, decim, out, j, st, ist, fail,
         st[S_H] = hh
         st[S_E] = ebar
         st[S_RIP] = dtr
+        if fam:
+            st[S_FEL] = fel_new
         st[S_DD] = b2 - d0
         st[S_IT] = it
         st[S_RB] = res_b
@@ -736,7 +824,8 @@ def _excite_py(th, tha, b1, rsum, dd, pfree, sep, eip, efp, etp, etg, els, array
 def advance_python(n_steps, rec_start, decim, out, j, st, ist, fail,
                    M, K0, C, Q0, Sinv, SK, SC, sQ, u, g, fp, ip,
                    dd0, ddd, phase_a, length_a, mesh_angle, n_cycles, n_seg, kvals,
-                   in_w, in_t, out_w, out_t, eip, efp, etp, etg, els, sp_t, sp_w):
+                   in_w, in_t, out_w, out_t, eip, efp, etp, etg, els, sp_t, sp_w,
+                   lf_force, lf_phase, lf_length, lf_vals):
     """Pure-Python/NumPy twin of :func:`advance` (same arguments and results).
 
     Written separately: it assembles the full effective matrix
@@ -749,6 +838,14 @@ def advance_python(n_steps, rec_start, decim, out, j, st, ist, fail,
     from ..stiffness.map import MapArrays
 
     arrays = MapArrays(dd0, ddd, phase_a, length_a, mesh_angle, n_cycles, n_seg, kvals)
+    family = [MapArrays(dd0, ddd, lf_phase[i], lf_length[i], mesh_angle, n_cycles, n_seg,
+                        lf_vals[i]) for i in range(lf_force.shape[0])]
+
+    def k_of_load(th, h, dd, force):
+        """K(theta, d, F): np.interp over the loads of the family's window averages."""
+        ks = [lookup_box_reference(th, h, dd, m) for m in family]
+        return float(np.interp(force, lf_force, ks))
+
     dt, beta, gam, al = fp[FP_DT], fp[FP_BETA], fp[FP_GAMMA], fp[FP_ALPHA]
     opa = 1 + al
     q, rsum, t1t2, d0 = fp[FP_QMB], fp[FP_RSUM], fp[FP_T1T2], fp[FP_D0]
@@ -827,8 +924,12 @@ def advance_python(n_steps, rec_start, decim, out, j, st, ist, fail,
         it, res_b, res, a_prev = 0, np.nan, np.nan, None
         history_b2, history_k, take_next = [], [], False
         status = OK
+        fel = st[S_FEL]
         while True:
-            kk = lookup_box_reference(th_k, hbox, b1 - d0, arrays)
+            if family and len(family) >= 2:
+                kk = k_of_load(th_k, hbox, b1 - d0, fel)
+            else:
+                kk = lookup_box_reference(th_k, hbox, b1 - d0, arrays)
             if np.isnan(kk):
                 status = MAP_RANGE
                 nf = 0.0
@@ -847,6 +948,10 @@ def advance_python(n_steps, rec_start, decim, out, j, st, ist, fail,
                 if it == 0:
                     res_b = res
                 conv = res < tol
+            if family and len(family) >= 2:
+                fel_new = hh * kk * frac * (g @ zn - ebar)
+                if abs(k_of_load(th_k, hbox, b1 - d0, fel_new) - kk) > rtol * abs(kk):
+                    conv = False
             if a_prev is not None:
                 da = (an - a_prev) @ M @ (an - a_prev)
                 sc = max(an @ M @ an, (opa * nf) ** 2 * fp[FP_UNORM] ** 2)
@@ -877,6 +982,8 @@ def advance_python(n_steps, rec_start, decim, out, j, st, ist, fail,
             a_prev = an
             if model2:
                 b1 = b2
+            if family and len(family) >= 2:
+                fel = fel_new
             it += 1
         if status != OK:
             fail[:] = [(n + 1) * dt, th, g @ xt, xt[1], xt[3], b1 - d0, nf, kk, it, res]
@@ -884,6 +991,8 @@ def advance_python(n_steps, rec_start, decim, out, j, st, ist, fail,
         st[S_Z:S_Z + 6], st[S_V:S_V + 6], st[S_A:S_A + 6] = zn, vn, an
         st[S_N], st[S_K], st[S_H], st[S_DD] = nf, kk * frac, hh, b2 - d0
         st[S_IT], st[S_RB], st[S_RA], st[S_E], st[S_RIP] = it, res_b, res, ebar, rip1
+        if family and len(family) >= 2:
+            st[S_FEL] = fel_new
         if in_nl:
             st[S_QIN] = q_in(vn[0])
         if out_nl:

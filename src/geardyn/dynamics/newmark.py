@@ -77,6 +77,9 @@ class KernelSetup:
     excitation: tuple = field(default_factory=K.no_excitation)
     #: target speed profile ``(times [s], speeds [rad/s])`` of a speed-controlled drive
     speed_profile: tuple = field(default_factory=lambda: (np.array([0.0, 1.0]), np.zeros(2)))
+    #: ``K(theta, d, F)``: ``(forces [N], phase_a, length_a, values)`` of maps at several loads
+    #: (:meth:`geardyn.stiffness.LoadFamily.kernel_arrays`); default: the one map
+    load_family: tuple = field(default_factory=K.no_family)
 
     def args(self) -> tuple:
         """The kernel arguments after ``fail``."""
@@ -85,7 +88,7 @@ class KernelSetup:
                 self.g, self.fp, self.ip,
                 m.dd0, m.ddd, m.phase_a, m.length_a, m.mesh_angle, m.n_cycles, m.n_seg, m.values,
                 self.in_table[0], self.in_table[1], self.out_table[0], self.out_table[1],
-                *self.excitation, *self.speed_profile)
+                *self.excitation, *self.speed_profile, *self.load_family)
 
     @property
     def dt(self) -> float:
@@ -103,7 +106,8 @@ def make_setup(M, K0, C, g, Q0, stiffness_map: StiffnessMap | MapArrays, *, dt: 
                input_speed: float = 0.0, output_speed: float = 0.0,
                excitation: tuple | None = None,
                ripple: tuple[float, float, float] = (0.0, 1.0, 0.0),
-               drive: tuple | None = None, stiffness_window: str = "step") -> KernelSetup:
+               drive: tuple | None = None, stiffness_window: str = "step",
+               load_family=None) -> KernelSetup:
     r"""Arrays for the kernel from a general 6-DOF system in deviation coordinates.
 
     The system is ``M z'' + C z' + K0 z + N g = Q0 + q(z')``, ``N = h (k p + q_mb p')``,
@@ -162,6 +166,11 @@ def make_setup(M, K0, C, g, Q0, stiffness_map: StiffnessMap | MapArrays, *, dt: 
         in proportion to the part of the step after it instead of at the step's end;
         ``"point"``: the map at the evaluation angle (geardyn before 2026-11-25, and the
         paper's flow chart).
+    load_family : geardyn.stiffness.LoadFamily, optional
+        ``K(theta, d, F)``: the stiffness read from maps at several loads, linear in each
+        step's elastic mesh force ``h k (p - e_bar)`` (iterated within the step until the
+        stiffness changes by less than ``rtol``); ``stiffness_map`` then serves the static
+        state and the tooth-error shares only.
     """
     if model not in ("I", "II"):
         raise InputError("simulation.model", model, "'I' or 'II'")
@@ -216,7 +225,9 @@ def make_setup(M, K0, C, g, Q0, stiffness_map: StiffnessMap | MapArrays, *, dt: 
                        u=np.ascontiguousarray(u), g=g, fp=fp, ip=ip, map_arrays=arrays,
                        in_table=laws[0][0].table(), out_table=laws[1][0].table(),
                        excitation=K.no_excitation() if excitation is None else excitation,
-                       speed_profile=profile)
+                       speed_profile=profile,
+                       load_family=K.no_family() if load_family is None
+                       else load_family.kernel_arrays())
 
 
 def _q_remainders(setup: KernelSetup, v: np.ndarray) -> tuple[float, float]:
@@ -286,6 +297,7 @@ def initial_state(setup: KernelSetup, z0, v0=None, step: int = 0) -> tuple[np.nd
     st[K.S_N], st[K.S_K], st[K.S_H], st[K.S_DD] = n0, k0, h0, d - fp[K.FP_D0]
     st[K.S_IT], st[K.S_RB], st[K.S_RA] = 0.0, np.nan, np.nan
     st[K.S_QIN], st[K.S_QOUT], st[K.S_E], st[K.S_RIP] = qin, qout, ebar, rip
+    st[K.S_FEL] = h0 * k0 * (p0 - ebar)  # elastic mesh force: the load of a K(theta, d, F)
     return st, np.array([step, 0], dtype=np.int64)
 
 
@@ -310,7 +322,7 @@ def run_steps(setup: KernelSetup, st: np.ndarray, ist: np.ndarray, n_steps: int,
 
 # --------------------------------------------------------------------------- the case
 def _setup_for_case(case, dyn: DynamicModel, stiffness_map: StiffnessMap, which: str,
-                    static: StaticState) -> KernelSetup:
+                    static: StaticState, load_family=None) -> KernelSetup:
     sim = case.simulation
     Q0, d_in, d_out = dyn.forcing_at_reference()
     C = dyn.C0.copy()
@@ -343,7 +355,21 @@ def _setup_for_case(case, dyn: DynamicModel, stiffness_map: StiffnessMap, which:
         excitation=mods.kernel_arrays(stiffness_map) if mods.active else None,
         ripple=(case.motor.ripple * float(dyn.input_law.torque(dyn.speed)),
                 case.motor.ripple_order, case.motor.ripple_phase),
-        drive=drive)
+        drive=drive, load_family=_family_view(load_family, which, static))
+
+
+def _family_view(load_family, which: str, static: StaticState):
+    """The family as model ``which`` reads it. The kernel reads every map of the family with
+    the ``dd`` origin of the case's map, which model I-static shifts
+    (:func:`fixed_distance_arrays`), so only the coverage is checked here."""
+    if load_family is not None and which == "I-static":
+        dd_shift = float(static.centre_distance_change)
+        for m in load_family.maps:
+            if not m.covers(dd_shift):
+                raise InputError("stiffness_map", f"range [{m.dd[0]:.6g}, {m.dd[-1]:.6g}] m",
+                                 f"maps covering the fixed centre distance change "
+                                 f"{dd_shift:.6g} m")
+    return load_family
 
 
 def fixed_distance_arrays(stiffness_map: StiffnessMap, centre_distance_change: float
@@ -491,13 +517,16 @@ def simulate(case, stiffness_map: StiffnessMap | None = None, *, model: str | No
         from ..stiffness import build_map
 
         stiffness_map = build_map(case, cracked=cracked)
+    from ..stiffness import build_load_family
+
+    family = build_load_family(case, cracked=cracked)  # None unless stiffness.fe.torques
     sim = case.simulation
     try:
         with np.errstate(over="raise", invalid="raise", divide="raise"):
             dyn = DynamicModel.from_case(case, stiffness_map)
             check_time_step(dyn, stiffness_map, sim.dt)
             static = static_equilibrium(dyn, stiffness_map, which=which)
-            setup = _setup_for_case(case, dyn, stiffness_map, which, static)
+            setup = _setup_for_case(case, dyn, stiffness_map, which, static, family)
     except GeardynError:
         raise
     except (FloatingPointError, OverflowError, ZeroDivisionError, ValueError,
@@ -766,6 +795,12 @@ def _dataset(case, dyn: DynamicModel, stiffness_map: StiffnessMap, which: str,
             "stiffness_contact_ratio_eq8": float(fixed["contact_ratio_eq8"][0]),
             "stiffness_contact_ratio_eq8_units": "1",
         })
+    if setup.load_family[0].size >= 2:
+        forces = setup.load_family[0]
+        attrs["stiffness_load_family"] = (
+            "K(theta, d, F): maps at mesh forces " + ", ".join(f"{f:.6g}" for f in forces)
+            + " N (pinion torques " + ", ".join(f"{t:.6g}" for t in case.stiffness.fe.torques)
+            + " N m), read at each step's elastic mesh force, linear between them")
     if setup.fp[K.FP_DRIVE_GAIN] != 0.0:
         tp, wp = setup.speed_profile
         attrs["speed_profile"] = (

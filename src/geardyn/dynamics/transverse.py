@@ -326,6 +326,10 @@ def _refuse_unsupported(case) -> None:
         raise InputError("simulation.dynamics", "transverse",
                          "'6-dof' for a case with tooth errors, tip relief or runout "
                          "(modifications): the transverse model does not take them yet")
+    if case.stiffness.method == "fe" and case.stiffness.fe.torques is not None:
+        raise InputError("stiffness.fe.torques", list(case.stiffness.fe.torques),
+                         "omitted with simulation.dynamics = 'transverse' (maps at several loads "
+                         "are read by the 6-DOF kernel only)")
     if case.simulation.integrator != "newmark":
         raise InputError("simulation.integrator", case.simulation.integrator,
                          "'newmark' with simulation.dynamics = 'transverse' (HHT-alpha is "

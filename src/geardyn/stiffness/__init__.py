@@ -13,7 +13,8 @@ import numpy as np
 from .map import MapArrays, StiffnessMap, lookup, lookup_reference
 
 __all__ = ["StiffnessMap", "MapArrays", "lookup", "lookup_reference", "build_map",
-           "map_inputs", "centre_distance_grid", "fe_torque"]
+           "map_inputs", "centre_distance_grid", "fe_torque", "build_load_family",
+           "LoadFamily"]
 
 
 def centre_distance_grid(case) -> np.ndarray:
@@ -63,6 +64,7 @@ def map_inputs(case, method: str, cracked: bool) -> dict:
     if method == "fe":
         fe = case.stiffness.fe.model_dump(mode="json")
         fe["torque"] = fe_torque(case)  # the resolved load: omitted = motor.torque
+        fe.pop("torques", None)  # a load family is several maps, each keyed by its torque
         if fe["definition"] == "secant":  # the default keeps the keys of earlier secant maps
             del fe["definition"]
         else:
@@ -151,3 +153,86 @@ def load_cached_map(path, key: str) -> StiffnessMap:
         raise DataFileError(path, f"holds the map of other inputs (inputs_hash {stored!r}, "
                                   f"expected {key!r})")
     return m
+
+
+class LoadFamily:
+    """Stiffness maps of one case at several mesh loads: ``K(theta, d, F)``.
+
+    Attributes
+    ----------
+    forces : ndarray
+        Mesh forces along the line of action the maps were built at, ``T / r_b1`` [N],
+        increasing.
+    torques : ndarray
+        The pinion torques [N m].
+    maps : list of StiffnessMap
+    """
+
+    def __init__(self, torques, maps, r_b1: float):
+        self.torques = np.asarray(torques, float)
+        self.forces = self.torques / float(r_b1)
+        self.maps = list(maps)
+        first = self.maps[0].arrays()
+        for m in self.maps[1:]:
+            a = m.arrays()
+            if (a.values.shape != first.values.shape or a.dd0 != first.dd0 or a.ddd != first.ddd
+                    or a.n_seg != first.n_seg or a.n_cycles != first.n_cycles
+                    or a.mesh_angle != first.mesh_angle):
+                from ..errors import InputError
+
+                raise InputError("stiffness.fe.torques", self.torques.tolist(),
+                                 "maps on one grid (the same case grid for every torque)")
+
+    def kernel_arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """``(forces, phase_a, length_a, values)`` stacked over the loads, for the kernel."""
+        arr = [m.arrays() for m in self.maps]
+        return (np.ascontiguousarray(self.forces),
+                np.ascontiguousarray(np.stack([a.phase_a for a in arr])),
+                np.ascontiguousarray(np.stack([a.length_a for a in arr])),
+                np.ascontiguousarray(np.stack([a.values for a in arr])))
+
+    def at(self, theta, dd: float, force: float) -> np.ndarray:
+        """``K(theta, dd, force)`` [N/m]: linear in the force between the maps, constant
+        beyond the ends."""
+        th = np.atleast_1d(np.asarray(theta, float))
+        ks = np.stack([np.asarray(m(th, np.full(th.shape, dd)), float) for m in self.maps])
+        return np.array([np.interp(force, self.forces, ks[:, i]) for i in range(th.size)])
+
+
+def build_load_family(case, *, cracked: bool = True,
+                      progress: Callable[[int, int], None] | None = None, cache=None
+                      ) -> LoadFamily | None:
+    """The FE maps of ``case`` at ``stiffness.fe.torques`` (each from the cache or computed), or
+    ``None`` when the case asks for one map (no ``torques``, or the PEM method, whose map does
+    not depend on the load).
+
+    With secant maps ``K_s(F) = F / delta(F)``, reading the stiffness at the elastic mesh force
+    of each step, ``F = K_s(F) p``, is the FE's nonlinear static force-deflection law
+    ``delta(F)`` (linear in ``F`` between the loads): a conservative force of ``p``.
+
+    Raises
+    ------
+    InputError
+        The operating torque (``stiffness.fe.torque`` or ``motor.torque``) outside the torques.
+    """
+    from ..errors import InputError
+
+    torques = case.stiffness.fe.torques
+    if torques is None or case.stiffness.method != "fe":
+        return None
+    if case.stiffness.fe.definition != "secant":
+        raise InputError("stiffness.fe.definition", case.stiffness.fe.definition,
+                         "'secant' with stiffness.fe.torques: the dynamics read F = K_s(F) p, "
+                         "the nonlinear force law of secant maps (a tangent map linearises "
+                         "about one load)")
+    t_op = fe_torque(case)
+    if not torques[0] <= t_op <= torques[-1]:
+        raise InputError("stiffness.fe.torques", list(torques),
+                         f"torques bracketing the operating torque {t_op:.6g} N m")
+    maps = []
+    for i, t in enumerate(torques):
+        sub = case.with_overrides({"stiffness.fe.torque": float(t)})
+        maps.append(build_map(sub, method="fe", cracked=cracked, cache=cache))
+        if progress is not None:
+            progress(i + 1, len(torques))
+    return LoadFamily(torques, maps, case.gear_pair().pinion.base_radius)
