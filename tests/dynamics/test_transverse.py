@@ -72,23 +72,38 @@ def test_friction_in_the_six_dof_model_is_refused(pem_case_and_map):
         simulate(case.with_overrides({"mesh.friction_coefficient": 0.05}), smap)
 
 
-def test_tooth_errors_are_refused_by_the_transverse_model(pem_case_and_map):
+ERRORS = {"modifications.pinion.grade": 6, "modifications.pinion.seed": 1,
+          "modifications.gear.grade": 6, "modifications.gear.seed": 2,
+          "modifications.pinion.tip_relief": 10e-6, "modifications.pinion.runout": 8e-6}
+
+
+@pytest.mark.parametrize("which", ["I", "II"])
+def test_with_tooth_errors_x_held_without_friction_is_the_six_dof_model(pem_case_and_map,
+                                                                        which):
+    """Class-6 pitch and profile errors, tip relief and runout (the excitation of issue 14):
+    with x held and no friction the transverse model gives the 6-DOF records to 1e-10."""
     case, smap = pem_case_and_map
-    bad = case.with_overrides({"simulation.dynamics": "transverse",
-                               "modifications.pinion.tip_relief": 10e-6})
-    with pytest.raises(InputError, match="simulation.dynamics"):
-        simulate(bad, smap)
+    case = case.with_overrides(ERRORS)
+    a = simulate(case, smap, model=which)
+    b = simulate_transverse(case, smap, model=which, x_free=False)
+    assert "mesh_error" in a and "mesh_error" in b
+    for v in VARS6 + ("mesh_error",):
+        x, y = a[v].values, b[v].values
+        scale = np.abs(x).max()
+        assert np.abs(x - y).max() <= 1e-10 * scale, (v, np.abs(x - y).max() / scale)
 
 
 # ----------------------------------------------------------------------------- twin
 @pytest.mark.parametrize("which", ["I", "II"])
 @pytest.mark.parametrize("mu", [0.0, 0.08])
-def test_kernel_equals_its_python_twin(pem_case_and_map, which, mu):
+@pytest.mark.parametrize("errors", [False, True])
+def test_kernel_equals_its_python_twin(pem_case_and_map, which, mu, errors):
     """Compiled kernel vs the separately written NumPy twin (full matrix solve), x free, the
-    PEM map with load shares, 400 steps: every variable to 1e-9 of its peak."""
+    PEM map with load shares, with and without tooth errors, 400 steps: every variable to 1e-9
+    of its peak."""
     case, smap = pem_case_and_map
     c = case.with_overrides({"simulation.settle_time": 0.0, "simulation.record_time": 0.004,
-                             "mesh.friction_coefficient": mu})
+                             "mesh.friction_coefficient": mu, **(ERRORS if errors else {})})
     a = simulate_transverse(c, smap, model=which)
     b = simulate_transverse(c, smap, model=which, python=True)
     for v in ("theta_p", "y_p", "x_p", "x_g", "omega_g", "v_xp", "mesh_force",

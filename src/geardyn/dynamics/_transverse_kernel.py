@@ -59,11 +59,11 @@ TI_XP, TI_YP, TI_THP, TI_XG, TI_YG, TI_THG, TI_OUT, TI_XFREE, TI_SHARES = range(
 N_TIP = 9
 # scalars after z, v, a in the state
 SC_N, SC_K, SC_H, SC_DD, SC_IT, SC_RB, SC_RA, SC_QIN, SC_QOUT, SC_RIP = range(10)
-SC_PHI, SC_MF, SC_A1, SC_A2, SC_P = 10, 11, 12, 13, 14
-N_SC = 15
+SC_PHI, SC_MF, SC_A1, SC_A2, SC_P, SC_E = 10, 11, 12, 13, 14, 15
+N_SC = 16
 # record columns after z, v
-RC_N, RC_DD, RC_K, RC_H, RC_IT, RC_RB, RC_RA, RC_PHI, RC_MF, RC_A1, RC_A2, RC_P = range(12)
-N_RC = 12
+RC_N, RC_DD, RC_K, RC_H, RC_IT, RC_RB, RC_RA, RC_PHI, RC_MF, RC_A1, RC_A2, RC_P, RC_E = range(13)
+N_RC = 13
 
 
 def state_layout(nd: int) -> tuple[int, int, int, int, int]:
@@ -227,7 +227,7 @@ def _deflection(z, tip, tfp, rsum, t1t2, tau, phi):
 def advance_transverse(n_steps, rec_start, decim, out, j, st, ist, fail,
                        M, K0, C, Q0, Sinv, SK, SC, sQ, g0, u0, fp, ip, tfp, tip,
                        dd0, ddd, phase_a, length_a, mesh_angle, n_cycles, n_seg, kvals, els,
-                       in_w, in_t, out_w, out_t, sp_t, sp_w):
+                       in_w, in_t, out_w, out_t, sp_t, sp_w, eip, efp, etp, etg):
     """Advance the transverse state ``st`` by up to ``n_steps`` steps (see the module text).
 
     Same calling convention as :func:`geardyn.dynamics._kernel.advance`; ``fp``/``ip`` are the
@@ -264,6 +264,8 @@ def advance_transverse(n_steps, rec_start, decim, out, j, st, ist, fail,
     const_vec = (not xfree) and mu == 0.0
     io = tip[TI_OUT]
     ithp = tip[TI_THP]
+    eact = eip[K.EI_ACTIVE] == 1  # tooth errors, relief, runout (geardyn.modifications)
+    hper = efp[K.EF_HPER]
     rb1 = tfp[TF_RB1]
     bdt2 = beta * dt * dt
     gdt = gam * dt
@@ -332,22 +334,20 @@ def advance_transverse(n_steps, rec_start, decim, out, j, st, ist, fail,
         status = K.OK
         dc, tau, phi = _geometry(zc, tip, rsum, t1t2)
         th_p = th_ref + zc[ithp]  # the predictor's pinion angle, kept over the iterations
+        tha_p = 0.0
+        if eact:
+            tha_p = (np.fmod(n * hstep, hper) if ev_start else np.fmod((n + 1) * hstep, hper)) \
+                + zc[ithp]
         mf = 0.0
         a1 = 0.0
         a2 = 0.0
         pt = 0.0
+        ebar = 0.0
+        frac = 1.0
+        shift = 0.0
+        k_pre = np.nan
         while True:
             b1 = dc if model2 else d0
-            th = th_p - phi
-            kk = lookup_box(th, hbox, b1 - d0, dd0, ddd, phase_a, length_a, mesh_angle,
-                            n_cycles, n_seg, kvals)
-            if kk != kk:
-                status = K.MAP_RANGE
-                break
-            if it == 0:
-                k_first = kk
-            mf, a1, a2 = _friction(th, rb1 * hbox, tau, b1 - d0, tfp, tip, dd0, ddd, phase_a,
-                                   length_a, mesh_angle, n_cycles, n_seg, kvals, els)
             gw = 0.0
             pdt = 0.0
             sig = 0.0
@@ -357,28 +357,54 @@ def advance_transverse(n_steps, rec_start, decim, out, j, st, ist, fail,
                     gw += g0[i] * w[i]
                     pt += g0[i] * xt[i]
                     pdt += g0[i] * vt[i]
-                    uc[i] = u0[i]
-                sig = tfp[TF_SIGMA0]
             else:
-                _mesh_vectors(zc, tip, tfp, phi, mf, a1, a2, gc, bc)
+                _mesh_vectors(zc, tip, tfp, phi, 0.0, 0.0, 0.0, gc, bc)
                 pt = _deflection(zc, tip, tfp, rsum, t1t2, tau, phi)
                 for i in range(nd):
                     gw += gc[i] * w[i]
                     pt += gc[i] * (xt[i] - zc[i])
                     pdt += gc[i] * vt[i]
+            if it == 0:  # contact decided once, by the free deflection at t_{n+1} (eq. 15)
+                hh = 1.0
+                if sep and pt + bdt2 * gw < 0.0:
+                    hh = 0.0
+                if eact:  # tooth errors: e_bar, the loaded pairs' share, runout's angle shift
+                    th0 = th_p - phi
+                    th_k, ebar, frac, hh, k_pre = K._excite(
+                        th0, tha_p - phi, b1, rsum, b1 - d0, pt + bdt2 * gw, sep, eip, efp,
+                        etp, etg, els, dd0, ddd, phase_a, length_a, mesh_angle, n_cycles, n_seg,
+                        kvals)
+                    shift = th0 - th_k
+            th = th_p - phi - shift
+            if it == 0 and k_pre == k_pre and hbox <= 0.0:  # found with the shares there
+                kk = k_pre
+            else:
+                kk = lookup_box(th, hbox, b1 - d0, dd0, ddd, phase_a, length_a, mesh_angle,
+                                n_cycles, n_seg, kvals)
+            if kk != kk:
+                status = K.MAP_RANGE
+                break
+            if it == 0:
+                k_first = kk
+            mf, a1, a2 = _friction(th, rb1 * hbox, tau, b1 - d0, tfp, tip, dd0, ddd, phase_a,
+                                   length_a, mesh_angle, n_cycles, n_seg, kvals, els)
+            if const_vec:
+                for i in range(nd):
+                    uc[i] = u0[i]
+                sig = tfp[TF_SIGMA0]
+            else:
+                _mesh_vectors(zc, tip, tfp, phi, mf, a1, a2, gc, bc)
+                for i in range(nd):
                     acc = 0.0
                     for k in range(nd):
                         acc += Sinv[i, k] * bc[k]
                     uc[i] = acc
                 for i in range(nd):
                     sig += gc[i] * uc[i]
-            if it == 0:  # contact decided once, by the free deflection at t_{n+1} (eq. 15)
-                hh = 1.0
-                if sep and pt + bdt2 * gw < 0.0:
-                    hh = 0.0
+            keff = kk * frac
             if hh > 0.0:
-                c = bdt2 * kk + gdt * q
-                nf = (kk * pt + q * pdt + c * gw) / (1.0 + c * sig)
+                c = bdt2 * keff + gdt * q
+                nf = (keff * (pt - ebar) + q * pdt + c * gw) / (1.0 + c * sig)
             else:
                 nf = 0.0
             for i in range(nd):
@@ -457,7 +483,8 @@ def advance_transverse(n_steps, rec_start, decim, out, j, st, ist, fail,
         else:
             p_n = _deflection(st, tip, tfp, rsum, t1t2, tau_n, phi_n)
         st[s_sc + SC_N] = nf
-        st[s_sc + SC_K] = kk
+        st[s_sc + SC_K] = kk * frac
+        st[s_sc + SC_E] = ebar
         st[s_sc + SC_H] = hh
         st[s_sc + SC_DD] = b2 - d0
         st[s_sc + SC_IT] = it
@@ -524,3 +551,4 @@ def _write_t(out, j, st, nd):
     out[j, rb + RC_A1] = st[base + SC_A1]
     out[j, rb + RC_A2] = st[base + SC_A2]
     out[j, rb + RC_P] = st[base + SC_P]
+    out[j, rb + RC_E] = st[base + SC_E]

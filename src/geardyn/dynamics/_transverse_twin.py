@@ -58,7 +58,7 @@ def _deflect(z, tip, tfp, t1t2):
 def advance_transverse_python(n_steps, rec_start, decim, out, j, st, ist, fail,
                               M, K0, C, Q0, Sinv, SK, SC, sQ, g0, u0, fp, ip, tfp, tip,
                               dd0, ddd, phase_a, length_a, mesh_angle, n_cycles, n_seg, kvals,
-                              els, in_w, in_t, out_w, out_t, sp_t, sp_w):
+                              els, in_w, in_t, out_w, out_t, sp_t, sp_w, eip, efp, etp, etg):
     """Same arguments and results as the kernel (ignores ``Sinv``, ``SK``, ``SC``, ``sQ``,
     ``u0``)."""
     arrays = MapArrays(dd0, ddd, phase_a, length_a, mesh_angle, n_cycles, n_seg, kvals)
@@ -124,7 +124,8 @@ def advance_transverse_python(n_steps, rec_start, decim, out, j, st, ist, fail,
         for rc, sc in ((T.RC_N, T.SC_N), (T.RC_DD, T.SC_DD), (T.RC_K, T.SC_K),
                        (T.RC_H, T.SC_H), (T.RC_IT, T.SC_IT), (T.RC_RB, T.SC_RB),
                        (T.RC_RA, T.SC_RA), (T.RC_PHI, T.SC_PHI), (T.RC_MF, T.SC_MF),
-                       (T.RC_A1, T.SC_A1), (T.RC_A2, T.SC_A2), (T.RC_P, T.SC_P)):
+                       (T.RC_A1, T.SC_A1), (T.RC_A2, T.SC_A2), (T.RC_P, T.SC_P),
+                       (T.RC_E, T.SC_E)):
             out[jj, rb + rc] = st[base + sc]
 
     n = int(ist[0])
@@ -154,27 +155,41 @@ def advance_transverse_python(n_steps, rec_start, decim, out, j, st, ist, fail,
             + zc[tip[T.TI_THP]]
         hbox = 0.5 * abs(hstep + dt * v[tip[T.TI_THP]]) if ip[K.IP_WINDOW] == 1 else 0.0
         dc, tau, phi = _geom(zc, tip, rsum, t1t2)
+        nn = n if ev_start else n + 1
+        tha_p = np.fmod(nn * hstep, efp[K.EF_HPER]) + zc[tip[T.TI_THP]] \
+            if eip[K.EI_ACTIVE] == 1 else 0.0
+        ebar, frac, shift = 0.0, 1.0, 0.0
         it, res_b, res, a_prev, hh = 0, np.nan, np.nan, None, 1.0
         history_b2, history_k, take_next = [], [], False
         status = K.OK
         nf = kk = 0.0
         while True:
             b1 = dc if model2 else d0
-            th = th_p - phi
+            g, _ = _vectors(nd, tip, tfp, phi, 0.0, 0.0, 0.0)
+            p_c = _deflect(zc, tip, tfp, t1t2) + g @ (xt - zc)
+            if it == 0:  # contact by the free deflection at t_{n+1}
+                a_free = np.linalg.solve(S, load - C @ vt - K0 @ xt)
+                p_free = p_c + beta * dt * dt * (g @ a_free)
+                hh = 0.0 if (sep and p_free < 0.0) else 1.0
+                if eip[K.EI_ACTIVE] == 1:  # tooth errors: the 6-DOF twin's excitation
+                    th0 = th_p - phi
+                    th_k, ebar, frac, hh = K._excite_py(th0, tha_p - phi, b1, rsum, b1 - d0,
+                                                        p_free, sep, eip, efp, etp, etg, els,
+                                                        arrays)
+                    shift = th0 - th_k
+            th = th_p - phi - shift
             kk = lookup_box_reference(th, hbox, b1 - d0, arrays)
             if np.isnan(kk):
                 status = K.MAP_RANGE
                 break
             m_f, a_1, a_2 = friction(th, rb1 * hbox, tau, b1 - d0)
             g, b = _vectors(nd, tip, tfp, phi, m_f, a_1, a_2)
-            p_c = _deflect(zc, tip, tfp, t1t2) + g @ (xt - zc)
-            if it == 0:  # contact by the free deflection at t_{n+1}
-                a_free = np.linalg.solve(S, load - C @ vt - K0 @ xt)
-                hh = 0.0 if (sep and p_c + beta * dt * dt * (g @ a_free) < 0.0) else 1.0
-            Seff = S + hh * (beta * dt * dt * kk + gam * dt * q) * np.outer(b, g)
-            rhs = load - C @ vt - K0 @ xt - hh * (kk * p_c + q * (g @ vt)) * b
+            ke = kk * frac
+            Seff = S + hh * (beta * dt * dt * ke + gam * dt * q) * np.outer(b, g)
+            rhs = load - C @ vt - K0 @ xt - hh * (ke * (p_c - ebar) + q * (g @ vt)) * b
             an = np.linalg.solve(Seff, rhs)
-            nf = hh * (kk * (p_c + beta * dt * dt * (g @ an)) + q * (g @ (vt + gam * dt * an)))
+            nf = hh * (ke * (p_c + beta * dt * dt * (g @ an) - ebar)
+                       + q * (g @ (vt + gam * dt * an)))
             zc = xt + beta * dt * dt * an
             dn, taun, phin = _geom(zc, tip, rsum, t1t2)
             b2 = dn
@@ -226,7 +241,8 @@ def advance_transverse_python(n_steps, rec_start, decim, out, j, st, ist, fail,
         _, _, phi_n = _geom(zn, tip, rsum, t1t2)
         p_n = _deflect(zn, tip, tfp, t1t2)
         sc = st[s_sc:]
-        sc[T.SC_N], sc[T.SC_K], sc[T.SC_H], sc[T.SC_DD] = nf, kk, hh, b2 - d0
+        sc[T.SC_N], sc[T.SC_K], sc[T.SC_H], sc[T.SC_DD] = nf, kk * frac, hh, b2 - d0
+        sc[T.SC_E] = ebar
         sc[T.SC_IT], sc[T.SC_RB], sc[T.SC_RA], sc[T.SC_RIP] = it, res_b, res, rip1
         sc[T.SC_PHI], sc[T.SC_MF], sc[T.SC_A1], sc[T.SC_A2] = phi_n, m_f, a_1, a_2
         sc[T.SC_P] = p_n

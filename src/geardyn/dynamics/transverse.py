@@ -310,7 +310,7 @@ class TransverseSetup:
                 self.g0, self.u0, self.fp, self.ip, self.tfp, self.tip,
                 m.dd0, m.ddd, m.phase_a, m.length_a, m.mesh_angle, m.n_cycles, m.n_seg, m.values,
                 self.shares, self.in_table[0], self.in_table[1], self.out_table[0],
-                self.out_table[1], *self.speed_profile)
+                self.out_table[1], *self.speed_profile, *self.base_setup.excitation[:4])
 
     @property
     def nd(self) -> int:
@@ -320,12 +320,6 @@ class TransverseSetup:
 
 def _refuse_unsupported(case) -> None:
     """Features of the 6-DOF kernel the transverse kernel does not have yet: a clear error."""
-    from ..modifications import ToothModifications
-
-    if ToothModifications.from_case(case).active:
-        raise InputError("simulation.dynamics", "transverse",
-                         "'6-dof' for a case with tooth errors, tip relief or runout "
-                         "(modifications): the transverse model does not take them yet")
     if case.stiffness.method == "fe" and case.stiffness.fe.torques is not None:
         raise InputError("stiffness.fe.torques", list(case.stiffness.fe.torques),
                          "omitted with simulation.dynamics = 'transverse' (maps at several loads "
@@ -418,7 +412,16 @@ def initial_transverse_state(setup: TransverseSetup, z0) -> tuple[np.ndarray, np
     else:
         p0 = float(setup.g0 @ z0)
     h0 = 0.0 if (setup.ip[K.IP_SEP] and p0 < 0) else 1.0
-    n0 = h0 * k0 * p0
+    ebar = 0.0
+    eip, efp, etp, etg, els = setup.base_setup.excitation
+    if eip[K.EI_ACTIVE] == 1:  # tooth errors (geardyn.modifications), as the 6-DOF start
+        d_e = d if model2 else fp[K.FP_D0]
+        th_k, ebar, frac, h0 = K._excite_py(th, z0[idx["theta_p"]] - phi, d_e, rsum, dd, p0,
+                                            bool(setup.ip[K.IP_SEP]), eip, efp, etp, etg, els,
+                                            m)
+        k0 = float(lookup_reference(np.array(th_k), np.array(dd), m)) * frac
+        th = th_k
+    n0 = h0 * k0 * (p0 - ebar)
     m_f, a_1, a_2 = _friction_at(setup, th, tau, dd)
     gen = generalised_mesh_force(n0, phi, tm.base.r_b1, tm.base.r_b2, m_f, a_1, a_2)
     f = setup.Q0 - setup.K0 @ z0
@@ -437,6 +440,7 @@ def initial_transverse_state(setup: TransverseSetup, z0) -> tuple[np.ndarray, np
     sc[T.SC_N], sc[T.SC_K], sc[T.SC_H], sc[T.SC_DD] = n0, k0, h0, d - fp[K.FP_D0]
     sc[T.SC_RB], sc[T.SC_RA], sc[T.SC_RIP] = np.nan, np.nan, rip
     sc[T.SC_PHI], sc[T.SC_MF], sc[T.SC_A1], sc[T.SC_A2], sc[T.SC_P] = phi, m_f, a_1, a_2, p0
+    sc[T.SC_E] = ebar
     return st, np.array([0, 0], dtype=np.int64)
 
 
@@ -514,7 +518,7 @@ def simulate_transverse(case, stiffness_map: StiffnessMap | None = None, *,
     Raises
     ------
     InputError, NumericalError
-        As :func:`geardyn.dynamics.simulate`; also tooth errors or HHT with this model.
+        As :func:`geardyn.dynamics.simulate`; also HHT or a load family with this model.
     """
     from .model import MODELS
     from .newmark import (
@@ -559,7 +563,10 @@ def simulate_transverse(case, stiffness_map: StiffnessMap | None = None, *,
     _check_record_size(count, sim)
     nd = setup.nd
     out = np.full((count, T.record_layout(nd)[3]), np.nan)
-    st, ist = initial_transverse_state(setup, tm.embed(static.z))
+    from .newmark import _start_with_errors
+
+    st, ist = initial_transverse_state(setup, tm.embed(
+        _start_with_errors(setup.base_setup, tm.base, static)))
     j = 0
     done = 0
     if progress is not None:
@@ -621,7 +628,7 @@ def transverse_dataset(case, setup: TransverseSetup, stiffness_map: StiffnessMap
     for rk, rt in ((K.R_N, T.RC_N), (K.R_DD, T.RC_DD), (K.R_K, T.RC_K), (K.R_H, T.RC_H),
                    (K.R_IT, T.RC_IT), (K.R_RB, T.RC_RB), (K.R_RA, T.RC_RA)):
         rows6[:, rk] = rows[:, r_sc + rt]
-    rows6[:, K.R_E] = 0.0
+    rows6[:, K.R_E] = rows[:, r_sc + T.RC_E]
     ds = _dataset(case, tm.base, stiffness_map, which, static, setup.base_setup, rows6,
                   n_settle, decim, complete)
     ds["mesh_deflection"] = ("time", rows[:, r_sc + T.RC_P], {
