@@ -190,6 +190,56 @@ class Cache:
         _note_lookup(kind, key, False)
         return obj, False
 
+    def write_file(self, kind: str, key: str, target: str | os.PathLike,
+                   write: Callable[[Path], None]) -> bool:
+        """Write the file ``target`` through the cache: a copy of the entry for ``key`` if there
+        is a valid one, else ``write(path)`` into a new entry that is then copied.
+
+        For output files that are a pure function of ``key`` (the caller hashes the data, the
+        writer's settings and the versions of the libraries that encode it), so that a run into
+        another folder copies the bytes instead of encoding and compressing them again. The
+        entry is checked like any other (checksum and key in the sidecar) while its lock is
+        held, and ``target`` is written atomically. Without the cache ``write(target)`` runs
+        (atomically).
+
+        Parameters
+        ----------
+        kind : str
+            Sub-folder of the cache.
+        key : str
+            Hash of everything the file's bytes depend on.
+        target : path-like
+            The file to write (its suffix is the entry's).
+        write : callable
+            ``write(path)`` writes the file to ``path`` (a temporary path).
+
+        Returns
+        -------
+        bool
+            Whether the bytes came from the cache.
+        """
+        import shutil
+
+        target = Path(target)
+        if not self.enabled:
+            with atomic_path(target, suffix=target.suffix) as tmp:
+                write(tmp)
+            return False
+        path = self.path(kind, key, target.suffix)
+        with _entry_lock(path):
+            remove_stale_temp_files(path.parent, path.name)
+            hit = False
+            if path.exists() or path.with_name(path.name + ".sha256").exists():
+                hit = self.valid(path, key)
+                if not hit:
+                    self.discard(path)
+            if not hit:
+                self.store(None, path, key, lambda _obj, tmp: write(tmp))
+            with atomic_path(target, suffix=target.suffix) as tmp:
+                shutil.copyfile(path, tmp)
+        _note_lookup(kind, key, hit)
+        return hit
+
     def store(self, obj: object, path: Path, key: str, save: Callable[[object, Path], None]) -> None:
         """Write ``obj`` to ``path`` atomically, then its sidecar."""
         with atomic_path(path, suffix=path.suffix) as tmp:

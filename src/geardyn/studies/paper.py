@@ -12,12 +12,17 @@ Stages run in order, each adding to the summary and to the output folder:
    then splits the model II - model I difference into the static shift and the centre-distance
    dynamics (``summary["model_comparison"]``).
 4. ``diagnostics``: TSA, spectra, residual, PWVD, demodulation, statistics (Tables 2, 3) and
-   condition metrics, healthy against cracked (Figs. 11-23).
+   condition metrics, healthy against cracked (Figs. 11-23); the diagnoses are cached, keyed by
+   the records' signals and the settings (:mod:`.paper_cache`).
 5. ``measurement``: the same indicators on a realistic measurement (housing accelerometer
    through the case's sensor chain, ISO 1328 tooth errors, noise, TSA from the tachometer), in
    four variants that separate the errors from the noise (:mod:`.paper_measurement`); reuses
    the maps and records, adds two cached simulations with tooth errors.
 6. ``report``: ``report.html``, ``results.nc`` and ``figures/`` (:mod:`.paper_report`).
+
+The output files that encode a map or a record (``stiffness_*.nc``, ``runs/*.nc``) and the
+figures go through the cache as well, so a run of the same inputs into a new folder copies them
+instead of encoding, compressing and drawing them again (issue 16; :mod:`.paper_cache`).
 
 After each stage the consistency checks and the comparisons with the paper are recomputed from
 the summary (:mod:`.paper_validation`). Module layout, one way only: this pipeline imports the
@@ -97,14 +102,36 @@ def _build_map_with_progress(build_map, case: Case, cracked: bool, result: Study
     return m
 
 
+class _ImportedOnCall:
+    """The function ``module.name``, imported when called.
+
+    It carries the function's ``__module__`` and ``__qualname__``, by which
+    :meth:`~.paper_result.FigureStore.cached` keys a figure, so a figure taken from the cache
+    does not import the module that draws it.
+    """
+
+    def __init__(self, module: str, name: str):
+        self.__module__ = module
+        self.__qualname__ = name
+
+    def __call__(self, *args, **kwargs):
+        import importlib
+
+        return getattr(importlib.import_module(self.__module__), self.__qualname__)(*args,
+                                                                                   **kwargs)
+
+
 def stiffness_stage(case: Case, out: Path, result: StudyResult) -> None:
     """Healthy and cracked stiffness maps (cached), NetCDF files and the Figs. 5-6 analogues."""
     import json
     import warnings
 
     from ..stiffness import build_map
-    from ..stiffness.plots import crack_angle, fig_crack, fig_load_sharing, fig_stiffness
 
+    # drawn only on a figure-cache miss: importing the plots imports matplotlib (issue 16)
+    fig_stiffness, fig_load_sharing, fig_crack = (
+        _ImportedOnCall("geardyn.stiffness.plots", name)
+        for name in ("fig_stiffness", "fig_load_sharing", "fig_crack"))
     map_case = _map_case(case, result.quick)
     if map_case is not case:
         what = [f"{map_case.stiffness.centre_distances} centre distances"]
@@ -125,26 +152,83 @@ def stiffness_stage(case: Case, out: Path, result: StudyResult) -> None:
             if text not in result.notes:
                 result.notes.append(text)
     result.maps = {"healthy": healthy, "cracked": cracked}
-    healthy.to_netcdf(out / "stiffness_healthy.nc")
-    cracked.to_netcdf(out / "stiffness_cracked.nc")
+    from .paper_cache import write_output
+
+    for state, m in result.maps.items():  # the bytes from the cache when an earlier run wrote them
+        write_output(out / f"stiffness_{state}.nc", "stiffness map", m, "StiffnessMap.to_netcdf",
+                     m.to_netcdf)
     result.figures.cached("fig5_stiffness", fig_stiffness, healthy)
     result.figures.cached("fig5_load_sharing", fig_load_sharing, healthy)
     if case.stiffness.method == "fe":
-        from ..stiffness.fe import plot_mesh
-
+        # imported only to draw: the FE package takes 0.2 s to import (issue 16)
+        plot_mesh = _ImportedOnCall("geardyn.stiffness.fe", "plot_mesh")
         result.figures.cached("fig_fe_mesh", plot_mesh, case,
                               cracked=case.crack is not None and case.crack.active)
-    if case.crack is not None and case.crack.active:
+    cracks = case.crack is not None and case.crack.active
+    dd_op = result.summary.get("static", {}).get("centre_distance_change_mm", 0.0) * 1e-3
+    dd_op = dd_op if cracked.covers(dd_op) else 0.0
+    numbers = map_numbers(healthy, cracked, cracks, dd_op)
+    if cracks:
         result.figures.cached("fig6_crack", fig_crack, healthy, cracked)
-        dd_op = result.summary.get("static", {}).get("centre_distance_change_mm", 0.0) * 1e-3
-        dd_op = dd_op if cracked.covers(dd_op) else 0.0
-        result.summary["crack_angle_in_stiffness_deg"] = math.degrees(
-            crack_angle(healthy, cracked, dd_op))
+        result.summary["crack_angle_in_stiffness_deg"] = math.degrees(numbers["crack_angle_op"])
         result.summary["crack_angle_in_stiffness_at_mm"] = dd_op * 1e3
-    th = np.linspace(0.0, healthy.period, 4096, endpoint=False)
-    result.summary["mean_mesh_stiffness_N_per_m"] = {
-        f"{dd * 1e3:+.1f}mm": float(np.mean(healthy(th, dd))) for dd in (0.0, 0.5e-3, 1.0e-3)
-        if healthy.covers(dd)}
+        result.crack_angle_rad = numbers["crack_angle_0"]
+    result.summary["mean_mesh_stiffness_N_per_m"] = numbers["mean"]
+
+
+#: Bump when :func:`map_numbers` changes meaning, so cached numbers are recomputed.
+MAP_NUMBERS_VERSION = "1"
+
+
+def map_numbers(healthy, cracked, cracks: bool, dd_op: float, cache=None) -> dict:
+    """The numbers the study reads off its two maps, through the cache (kind ``map values``).
+
+    Evaluating a map starts numba (0.3-0.4 s to load the compiled lookup), which a run whose
+    records come from the cache needs for nothing else (issue 16). Keyed by the maps' content,
+    ``cracks``, ``dd_op`` and geardyn's sources; the values are stored as JSON (Python's float
+    text round-trips exactly).
+
+    Parameters
+    ----------
+    healthy, cracked : StiffnessMap
+    cracks : bool
+        Whether the case has an active crack (the crack angles are computed only then).
+    dd_op : float
+        Centre distance change of the static operating point [m], within the maps.
+
+    Returns
+    -------
+    dict
+        ``"mean"``: mean healthy mesh stiffness [N/m] over one period at +0.0, +0.5 and
+        +1.0 mm (those the map covers), keyed ``"+0.5mm"``; with ``cracks``,
+        ``"crack_angle_op"`` and ``"crack_angle_0"``: pinion angle [rad] where the cracked map
+        falls furthest below the healthy one, at ``dd_op`` and at 0
+        (:func:`geardyn.stiffness.plots.crack_angle`).
+    """
+    import json
+
+    from ..cache import default_cache
+    from .paper_cache import fingerprint
+    from .paper_result import _source_digest
+
+    def build() -> dict:
+        from ..stiffness.plots import crack_angle
+
+        th = np.linspace(0.0, healthy.period, 4096, endpoint=False)
+        out: dict = {"mean": {f"{dd * 1e3:+.1f}mm": float(np.mean(healthy(th, dd)))
+                              for dd in (0.0, 0.5e-3, 1.0e-3) if healthy.covers(dd)}}
+        if cracks:
+            out["crack_angle_op"] = crack_angle(healthy, cracked, dd_op)
+            out["crack_angle_0"] = crack_angle(healthy, cracked, 0.0)
+        return out
+
+    key = fingerprint("map numbers", MAP_NUMBERS_VERSION, healthy, cracked, bool(cracks),
+                      float(dd_op), _source_digest())[:32]
+    data, _ = (cache or default_cache()).get_or_build(
+        "map values", key, ".json", build,
+        save=lambda obj, path: Path(path).write_text(json.dumps(obj)),
+        load=lambda path: json.loads(Path(path).read_text()))
+    return data
 
 
 #: Bump when the simulation or its inputs change meaning, so cached records are recomputed.
@@ -200,11 +284,14 @@ def cached_simulation(case: Case, stiffness_map, model: str, cache=None):
 
 
 def _crack_angle(case: Case, result: StudyResult) -> float | None:
-    """Pinion angle [rad] where the crack lowers the stiffness most (from the maps)."""
-    from ..stiffness.plots import crack_angle
-
+    """Pinion angle [rad] where the crack lowers the stiffness most (from the maps, at 0 mm;
+    the stiffness stage has it already)."""
     if case.crack is None or not case.crack.active or "cracked" not in result.maps:
         return None
+    if result.crack_angle_rad is not None:
+        return result.crack_angle_rad
+    from ..stiffness.plots import crack_angle
+
     return crack_angle(result.maps["healthy"], result.maps["cracked"], 0.0)
 
 
@@ -248,6 +335,18 @@ def write_run_netcdf(ds, path: Path) -> None:
         ds.to_netcdf(tmp, engine="h5netcdf", encoding=_encoding(ds, RUN_ENCODING_FLOAT32))
 
 
+def _write_run_file(ds, path: Path) -> None:
+    """:func:`write_run_netcdf` through the cache (:func:`.paper_cache.write_output`): a run
+    into another folder copies the bytes an earlier run wrote for the same record."""
+    from .paper_cache import write_output
+
+    def write(tmp: Path) -> None:
+        ds.to_netcdf(tmp, engine="h5netcdf", encoding=_encoding(ds, RUN_ENCODING_FLOAT32))
+
+    write_output(path, "run", (ds, list(ds.variables)),
+                 {"float32": RUN_ENCODING_FLOAT32, "compression": COMPRESSION}, write)
+
+
 def simulation_stage(case: Case, out: Path, result: StudyResult) -> None:
     """Model I, I-static and II, cracked and healthy; the paper's flow-chart variant for Fig. 9;
     the model comparison (:func:`model_comparison`).
@@ -276,7 +375,7 @@ def simulation_stage(case: Case, out: Path, result: StudyResult) -> None:
             ds = cached_simulation(sim_case, result.maps[state], model)
         runs[(model, state)] = ds
         path = out / "runs" / run_file_name(model, state)
-        write_run_netcdf(ds, path)
+        _write_run_file(ds, path)
         result.files[f"run {model} {state}"] = path
         result.emit(f"simulation: {label}", i + 1, total)
     result.sims = runs
@@ -384,16 +483,21 @@ def model_comparison(runs: dict) -> dict:
     return out
 
 
+def _diagnosis_inputs(case: Case, ds) -> dict:
+    """The keyword arguments of :func:`geardyn.diagnostics.diagnose` for one record."""
+    d = case.diagnostics
+    return dict(signals={k: ds[k].values for k in SIGNAL_KEYS}, teeth=case.pinion.teeth,
+                angle=ds["theta_p"].values, time=ds["time"].values,
+                samples_per_rev=d.samples_per_rev, harmonic=d.harmonic, bandwidth=d.bandwidth,
+                residual_preset=d.residual_preset,
+                units={"v_yg": "m/s", "omega_p": "rad/s", "transmission_error": "rad"},
+                source=f"geardyn simulation, model {ds.attrs.get('model')}")
+
+
 def _diagnose_run(case: Case, ds):
     from ..diagnostics import diagnose
 
-    d = case.diagnostics
-    return diagnose({k: ds[k].values for k in SIGNAL_KEYS}, teeth=case.pinion.teeth,
-                    angle=ds["theta_p"].values, time=ds["time"].values,
-                    samples_per_rev=d.samples_per_rev, harmonic=d.harmonic, bandwidth=d.bandwidth,
-                    residual_preset=d.residual_preset,
-                    units={"v_yg": "m/s", "omega_p": "rad/s", "transmission_error": "rad"},
-                    source=f"geardyn simulation, model {ds.attrs.get('model')}")
+    return diagnose(**_diagnosis_inputs(case, ds))
 
 
 def paper_tables(cracked: dict) -> tuple[dict, dict]:
@@ -467,21 +571,43 @@ UNDEFINED_BASELINE_REASON = (
 
 def diagnostics_stage(case: Case, out: Path, result: StudyResult) -> None:
     """The paper's diagnostics on the three signals; Tables 2, 3; healthy vs cracked."""
+    from ..cache import default_cache
     from ..diagnostics import condition_metrics, residual
     from ..diagnostics.metrics import central_moment
     from . import paper_figures as pf
+    from .paper_cache import cached_diagnosis, diagnosis_key, fingerprint
+    from .paper_result import Deferred
 
     z = case.pinion.teeth
-    diags = {}
+    cache = default_cache()
+    diags, inputs, keys_of, full = {}, {}, {}, {}
     keys = [k for k in result.sims if k[0] in ("I", "II") or k == ("I-static", "cracked")]
+    drawn = (("I", "cracked"), ("II", "cracked"))  # only these are drawn as PWVDs
     for i, key in enumerate(keys):
         result.emit(f"diagnostics: model {key[0]}, {key[1]}", i, len(keys))
-        diags[key] = _diagnose_run(case, result.sims[key])
-        if key not in (("I", "cracked"), ("II", "cracked")):  # only these are drawn as PWVDs
-            diags[key] = _without_distributions(diags[key])
+        # through the cache, keyed by the record's signals and the settings (issue 16): a run of
+        # the same inputs into another folder diagnoses nothing again
+        inputs[key] = _diagnosis_inputs(case, result.sims[key])
+        keys_of[key] = diagnosis_key(inputs[key])
+        diags[key], computed = cached_diagnosis(inputs[key], keys_of[key], cache)
+        if computed is not None and key in drawn:
+            full[key] = computed  # kept for the figures (their PWVDs)
         result.emit(f"diagnostics: model {key[0]}, {key[1]}", i + 1, len(keys))
-    result.diagnoses = diags
+    result.diagnoses = diags  # without the PWVD distributions
     cracked = {m: diags[(m, "cracked")] for m in ("I", "II")}
+
+    def cracked_full() -> dict:
+        """The cracked diagnoses with their PWVDs, for a figure the cache does not hold."""
+        from ..diagnostics import diagnose
+
+        for k in drawn:
+            if k not in full:
+                full[k] = diagnose(**inputs[k])
+        return {m: full[(m, "cracked")] for m in ("I", "II")}
+
+    # the figures know the diagnoses by their cache keys and compute them only when drawn
+    cracked_figs = Deferred(fingerprint("cracked diagnoses", [keys_of[k] for k in drawn]),
+                            cracked_full)
 
     t2, t3 = paper_tables({**cracked, **({"I-static": diags[("I-static", "cracked")]}
                                          if ("I-static", "cracked") in diags else {})})
@@ -522,33 +648,26 @@ def diagnostics_stage(case: Case, out: Path, result: StudyResult) -> None:
 
     # Figs. 11-23
     F = result.figures
-    F.cached("fig11_tsa", pf.fig_tsa, cracked)
-    F.cached("fig12_spectra", pf.fig_spectra, cracked, z)
-    F.cached("fig13_residuals", pf.fig_residuals, cracked)
+    F.cached("fig11_tsa", pf.fig_tsa, cracked_figs)
+    F.cached("fig12_spectra", pf.fig_spectra, cracked_figs, z)
+    F.cached("fig13_residuals", pf.fig_residuals, cracked_figs)
     max_order = 6 * z
-    F.cached("fig14_pwvd_tsa_gear", pf.fig_pwvd_pair, cracked, "v_yg", "tsa", z, max_order)
+    F.cached("fig14_pwvd_tsa_gear", pf.fig_pwvd_pair, cracked_figs, "v_yg", "tsa", z, max_order)
     numbers = {"v_yg": (15, 16, 17), "omega_p": (18, 19, 20), "transmission_error": (21, 22, 23)}
     for sig, (a, b, c) in numbers.items():
-        F.cached(f"fig{a}_pwvd_residual_{sig}", pf.fig_pwvd_pair, cracked, sig, "residual", z,
-                 max_order)
-        F.cached(f"fig{b}_demodulation_{sig}", pf.fig_demodulation_pair, cracked, sig)
-        F.cached(f"fig{c}_analytic_{sig}", pf.fig_analytic_pair, cracked, sig)
-    # the figures are rendered: drop the time-frequency distributions (tens of MB per signal and
-    # run), which no later stage reads
-    result.diagnoses = {k: _without_distributions(d) for k, d in diags.items()}
+        F.cached(f"fig{a}_pwvd_residual_{sig}", pf.fig_pwvd_pair, cracked_figs, sig, "residual",
+                 z, max_order)
+        F.cached(f"fig{b}_demodulation_{sig}", pf.fig_demodulation_pair, cracked_figs, sig)
+        F.cached(f"fig{c}_analytic_{sig}", pf.fig_analytic_pair, cracked_figs, sig)
+    # the figures are rendered: the time-frequency distributions (tens of MB per signal and
+    # run), which no later stage reads, are dropped with ``full``
 
 
 def _without_distributions(diag):
     """``diag`` with each signal's PWVD distributions emptied (angles and orders kept)."""
-    import dataclasses
+    from .paper_cache import without_distributions
 
-    def empty(p):
-        return dataclasses.replace(p, distribution=np.zeros((0, 0)))
-
-    return dataclasses.replace(diag, signals={
-        name: dataclasses.replace(sd, pwvd_tsa=empty(sd.pwvd_tsa),
-                                  pwvd_residual=empty(sd.pwvd_residual))
-        for name, sd in diag.signals.items()})
+    return without_distributions(diag)
 
 
 def measurement_stage(case: Case, out: Path, result: StudyResult) -> None:

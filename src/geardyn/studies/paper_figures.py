@@ -7,9 +7,12 @@ out (no pyplot state). Model I is drawn on the left and model II on the right, a
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
-from matplotlib.figure import Figure
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 __all__ = ["SIGNALS", "fig8_design_parameters", "fig9_iteration", "fig10_stiffness",
            "fig_tsa", "fig_spectra", "fig_residuals", "fig_pwvd_pair", "fig_demodulation_pair",
@@ -23,6 +26,14 @@ SIGNALS = {
 }
 MODELS = ("I", "II")
 COLORS = {"I": "#1f77b4", "II": "#d62728", "I-static": "#2ca02c"}
+
+
+def _new_figure(**kwargs) -> Figure:
+    """A :class:`matplotlib.figure.Figure`; matplotlib is imported here, when a figure is drawn,
+    so a run that takes every figure from the cache does not import it (issue 16)."""
+    from matplotlib.figure import Figure
+
+    return Figure(**kwargs)
 
 
 def crack_times(ds, crack_angle: float) -> np.ndarray:
@@ -51,7 +62,7 @@ def fig8_design_parameters(ds, crack_angle: float | None, window: tuple[float, f
 
     The physical contact ratio and the paper's eq. 8 value differ by more than their
     variation, so each has its own panel (on one axis both would look flat)."""
-    fig = Figure(figsize=(8.5, 8.6), layout="constrained")
+    fig = _new_figure(figsize=(8.5, 8.6), layout="constrained")
     axs = fig.subplots(4, 1, sharex=True)
     sel = _window(ds, *window)
     t_all = ds["time"].values
@@ -84,7 +95,7 @@ def fig9_iteration(ds_scheme, ds_default, crack_angle: float | None,
     """Fig. 9 analogue: |b1 - b2| before and after the iteration, iterations per step and the
     mesh stiffness used, for the paper's start-of-step scheme; the default (predictor) run's
     first-solve |b1 - b2| is shown for comparison."""
-    fig = Figure(figsize=(8.5, 7.5), layout="constrained")
+    fig = _new_figure(figsize=(8.5, 7.5), layout="constrained")
     axs = fig.subplots(3, 1, sharex=True)
     sel = _window(ds_scheme, *window)
     t = ds_scheme["time"].values[sel]
@@ -119,7 +130,7 @@ def fig10_stiffness(ds_i, ds_ii, crack_angle: float | None, window: tuple[float,
 
     With ``ds_i_static`` (a model I-static record) its K_m(theta, d_s) at the static operating
     centre distance is drawn dashed over model II's (the paper has no such curve)."""
-    fig = Figure(figsize=(8.5, 3.8), layout="constrained")
+    fig = _new_figure(figsize=(8.5, 3.8), layout="constrained")
     ax = fig.subplots()
     curves = [(ds_i, r"model I, $K_m(\theta)$", "I", "-", 0.9),
               (ds_ii, r"model II, $K_m(\theta, d)$", "II", "-", 0.9)]
@@ -142,7 +153,7 @@ def fig10_stiffness(ds_i, ds_ii, crack_angle: float | None, window: tuple[float,
 
 
 def _grid(title_fn, plot_fn, diags: dict, signals=SIGNALS, figsize=(11.0, 8.0)) -> Figure:
-    fig = Figure(figsize=figsize, layout="constrained")
+    fig = _new_figure(figsize=figsize, layout="constrained")
     axs = fig.subplots(len(signals), 2, squeeze=False)
     for i, sig in enumerate(signals):
         for j, m in enumerate(MODELS):
@@ -216,7 +227,7 @@ def fig_residuals(diags: dict) -> Figure:
 
 def fig_pwvd_pair(diags: dict, sig: str, which: str, teeth: int, max_order: float) -> Figure:
     """Figs. 14/15/18/21 analogues: PWVD of the TSA (``which="tsa"``) or of the residual."""
-    fig = Figure(figsize=(11.0, 4.3), layout="constrained")
+    fig = _new_figure(figsize=(11.0, 4.3), layout="constrained")
     axs = fig.subplots(1, 2, sharey=True)
     for ax, m in zip(axs, MODELS, strict=True):
         sd = diags[m].signals[sig]
@@ -245,7 +256,7 @@ def fig_pwvd_pair(diags: dict, sig: str, which: str, teeth: int, max_order: floa
 
 def fig_demodulation_pair(diags: dict, sig: str) -> Figure:
     """Figs. 16/19/22 analogues: narrowband envelope, amplitude and phase modulation."""
-    fig = Figure(figsize=(11.0, 7.5), layout="constrained")
+    fig = _new_figure(figsize=(11.0, 7.5), layout="constrained")
     axs = fig.subplots(3, 2, sharex=True)
     unit = SIGNALS[sig][1]
     for j, m in enumerate(MODELS):
@@ -272,7 +283,7 @@ def fig_demodulation_pair(diags: dict, sig: str) -> Figure:
 def fig_analytic_pair(diags: dict, sig: str) -> Figure:
     """Figs. 17/20/23 analogues: the baseband analytic signal of the demodulated harmonic in the
     complex plane (radius = AM, angle = PM), both models."""
-    fig = Figure(figsize=(6.0, 5.6), layout="constrained")
+    fig = _new_figure(figsize=(6.0, 5.6), layout="constrained")
     ax = fig.subplots()
     for m in MODELS:
         z = diags[m].signals[sig].demodulation.baseband
@@ -310,7 +321,7 @@ def fig_measured_tsa(tsas: dict, model: str) -> Figure:
         Model of the simulations (title).
     """
     g = 9.80665
-    fig = Figure(figsize=(11.0, 6.0), layout="constrained")
+    fig = _new_figure(figsize=(11.0, 6.0), layout="constrained")
     axs = fig.subplots(2, 1, sharex=True)
     for ax, state in zip(axs, ("healthy", "cracked"), strict=True):
         for name, (color, lw, label) in MEASURED_STYLE.items():
@@ -339,7 +350,7 @@ def fig_model_comparison(comparison: dict) -> Figure:
         (``summary["model_comparison"]`` of the study).
     """
     states = [st for st in ("cracked", "healthy") if st in comparison]
-    fig = Figure(figsize=(10.0, 3.4 * max(1, len(states))), layout="constrained")
+    fig = _new_figure(figsize=(10.0, 3.4 * max(1, len(states))), layout="constrained")
     axs = np.atleast_1d(fig.subplots(max(1, len(states)), 1, squeeze=False)[:, 0])
     for ax, st in zip(axs, states, strict=False):
         sig = comparison[st]["signals"]

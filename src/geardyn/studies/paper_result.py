@@ -29,7 +29,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
-__all__ = ["StudyResult", "Progress"]
+__all__ = ["StudyResult", "Progress", "Deferred", "FigureStore", "RenderedFigure"]
 
 Progress = Callable[[str, int, int], None]
 
@@ -129,6 +129,50 @@ class _Undigestable(Exception):
     """An argument the figure cache cannot fingerprint (the figure is then drawn, not cached)."""
 
 
+#: NumPy scalar types (``dtype.str`` without the byte order) fingerprinted as the Python scalar
+#: they hold: float64, int64, bool, complex128 (what NetCDF gives back for a Python attribute);
+#: NumPy strings and bytes too.
+_PYTHON_SCALARS = ("f8", "i8", "b1", "c16")
+
+
+class Deferred:
+    """A figure argument known by a fingerprint and computed only if the figure is drawn.
+
+    Passed as a positional or keyword argument of :meth:`FigureStore.cached` (not inside a
+    container), which fingerprints it by ``fingerprint`` alone and calls ``compute()`` (once)
+    on a cache miss. The fingerprint must identify the value: the hash of everything it
+    is computed from (e.g. a diagnosis by its input signals, settings and geardyn's sources).
+
+    Parameters
+    ----------
+    fingerprint : str
+        Hash of the value's inputs.
+    compute : callable
+        ``compute() -> value``.
+    """
+
+    __slots__ = ("fingerprint", "_compute", "_value")
+
+    def __init__(self, fingerprint: str, compute: Callable[[], object]):
+        self.fingerprint = str(fingerprint)
+        self._compute = compute
+        self._value: tuple = ()
+
+    def value(self):
+        """The value (computed on the first call)."""
+        if not self._value:
+            self._value = (self._compute(),)
+        return self._value[0]
+
+
+def _resolve(args: tuple, kwargs: dict) -> tuple[tuple, dict]:
+    """``args`` and ``kwargs`` with each :class:`Deferred` replaced by its value."""
+    def one(a):
+        return a.value() if isinstance(a, Deferred) else a
+
+    return tuple(one(a) for a in args), {k: one(v) for k, v in kwargs.items()}
+
+
 def _digest(obj, h) -> None:
     """Feed a canonical fingerprint of ``obj`` to the hash ``h`` (arrays by dtype, shape and
     bytes; dataclasses, mappings and sequences element by element; xarray objects by their
@@ -137,7 +181,14 @@ def _digest(obj, h) -> None:
 
     import numpy as np
 
-    if obj is None or isinstance(obj, (bool, int, float, complex, str, bytes)):
+    if isinstance(obj, np.generic) and (obj.dtype.str[1:] in _PYTHON_SCALARS
+                                        or obj.dtype.kind in "US"):
+        # a NetCDF round trip turns a Python float/int attribute into np.float64/np.int64: the
+        # same value, the same figure (issue 16: the first warm run redrew 6 figures for this)
+        obj = obj.item()
+    if isinstance(obj, Deferred):
+        h.update(f"deferred:{obj.fingerprint};".encode())
+    elif obj is None or isinstance(obj, (bool, int, float, complex, str, bytes)):
         h.update(f"{type(obj).__name__}:{obj!r};".encode())
     elif isinstance(obj, np.generic):
         h.update(f"{obj.dtype}:{obj.item()!r};".encode())
@@ -180,10 +231,11 @@ def _source_digest() -> str:
     global _SOURCE_DIGEST
     if _SOURCE_DIGEST is None:
         import hashlib
+        from importlib import metadata
 
-        import matplotlib
-
-        h = hashlib.sha256(f"matplotlib {matplotlib.__version__}; dpi {FIGURE_DPI};".encode())
+        # the installed version, read without importing matplotlib (0.25 s; issue 16)
+        h = hashlib.sha256(f"matplotlib {metadata.version('matplotlib')}; dpi {FIGURE_DPI};"
+                           .encode())
         root = Path(__file__).resolve().parents[1]
         for path in sorted(root.rglob("*.py")):
             h.update(str(path.relative_to(root)).encode())
@@ -217,8 +269,9 @@ class FigureStore(dict):
         """``self[key] = draw(*args, **kwargs)``, through the disk cache (kind ``figure``): the
         PNG is keyed by a fingerprint of the arguments (:func:`_digest`), ``draw``'s name and
         geardyn's sources, so a run whose inputs did not change takes its figures from the
-        cache instead of drawing them again (issue 16.6). Arguments it cannot fingerprint, or
-        ``GEARDYN_NO_CACHE``, draw the figure as before."""
+        cache instead of drawing them again (issue 16.6). A :class:`Deferred` argument counts
+        by its fingerprint and is computed only when the figure is drawn. Arguments it cannot
+        fingerprint, or ``GEARDYN_NO_CACHE``, draw the figure as before."""
         import hashlib
 
         from ..cache import default_cache
@@ -228,12 +281,14 @@ class FigureStore(dict):
             _digest(args, h)
             _digest(kwargs, h)
         except _Undigestable:
+            args, kwargs = _resolve(args, kwargs)
             self[key] = draw(*args, **kwargs)
             return
         h.update(_source_digest().encode())
 
         def build() -> bytes:
-            self[key] = draw(*args, **kwargs)
+            a, kw = _resolve(args, kwargs)
+            self[key] = draw(*a, **kw)
             return dict.__getitem__(self, key).png
 
         png, _ = default_cache().get_or_build("figure", h.hexdigest(), ".png", build,
