@@ -258,10 +258,12 @@ def test_tiny_study_structure(tiny):
     ds, stages, _ = tiny
     assert dict(ds.sizes) == {"crack_depth": 1, "damping_ratio": 1, "bearing_stiffness": 2,
                               "pinion_speed": 2, "signal": len(SIGNALS), "convergence_dt": 4,
-                              "convergence_signal": len(MAIN_SIGNALS)}
+                              "convergence_signal": len(MAIN_SIGNALS), "runup_window": 60,
+                              "runup_signal": len(MAIN_SIGNALS)}
     assert ds.crack_depth.values.tolist() == [5e-3] and ds.damping_ratio.values.tolist() == [0.05]
     for name, var in ds.variables.items():
-        if name not in ("signal", "convergence_signal", "error"):
+        if name not in ("signal", "convergence_signal", "runup_signal", "runup_window",
+                        "error"):
             assert "units" in var.attrs, name
     # k = 1e5 N/m: not run, NaN
     assert np.all(ds.status_ii.values[..., 0, :] == NOT_RUN)
@@ -276,7 +278,8 @@ def test_tiny_study_structure(tiny):
     # the time-step check ran at the largest ratio; its reference has zero error
     assert ds.attrs["convergence_status"] == "ok"
     assert np.all(ds.convergence_error_predictor.values[-1] == 0)
-    assert stages[-1][0] == "time-step check" and ("simulations", 4, 4) in stages
+    assert ("time-step check", 1, 1) in stages and ("simulations", 4, 4) in stages
+    assert stages[-1] == ("run-up", 2, 2) and ds.attrs["runup_status"] == "ok"
 
 
 @pytest.mark.slow
@@ -285,6 +288,7 @@ def test_tiny_study_page_and_resume(tiny):
     page = write_report(ds, tmp / "page", command="test")
     text = page.read_text()
     assert "Range explored" in text and "data:image/png;base64," in text
+    assert "A run-up through the centre-distance mode" in text
     assert (tmp / "page" / "figures" / "ratio_maps.png").stat().st_size > 10_000
     from distributed import Client
 

@@ -96,6 +96,15 @@ def model_ii(
                   f"{ds.attrs['sweep_computed_now']} computed now on {ds.attrs['workers']} "
                   f"worker(s)) in {ds.attrs['run_seconds']:.0f} s", highlight=False)
     console.print(s["sentence"], highlight=False, soft_wrap=True)
+    if ds.attrs.get("runup_status") == "ok":
+        from ..studies.model_regimes_report import runup_summary
+
+        ru = runup_summary(ds)
+        console.print(f"run-up through the centre-distance mode ({ru['mode']:.4g} Hz): "
+                      f"largest ratio {ru['max']:.3g} ({ru['max_signal']}) at "
+                      f"{ru['max_ratio']:.3g} x the mode's frequency; above the threshold in "
+                      f"{ru['above']} of {ru['windows']} windows", highlight=False,
+                      soft_wrap=True)
     if ds.attrs.get("sweep_pending"):
         err_console.print(f"[red]{ds.attrs['sweep_pending']} run(s) still pending[/red]: re-run "
                           "the same command to compute them", highlight=False)

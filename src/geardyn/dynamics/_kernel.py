@@ -372,6 +372,21 @@ def _excite(th, tha, b1, rsum, dd, pfree, sep, eip, efp, etp, etg, els,
 
 
 @numba.njit(cache=True, nogil=True, fastmath=False)
+def no_fixed_point(take_next, it, b2, b2_m2, res, tol, kk, k_first, k_m1):
+    """Model II's rule for a step without a fixed point (module text): the iterates settle into
+    a two-cycle across a contact zone boundary (``|b2_m - b2_{m-2}| <= 1e-3 tol`` while
+    ``|b1 - b2| >= tol``); accept the solve on the first solve's side. Returns
+    ``(accept, take_next)``: accept now, or mark the next solve as the one to accept."""
+    if take_next:
+        return True, take_next
+    if it >= 2 and abs(b2 - b2_m2) <= 1e-3 * tol and res >= tol:
+        if abs(kk - k_first) <= abs(k_m1 - k_first):
+            return True, take_next
+        return False, True
+    return False, take_next
+
+
+@numba.njit(cache=True, nogil=True, fastmath=False)
 def family_lookup(theta, h, dd, force, dd0, ddd, mesh_angle, n_cycles, n_seg, lf_force,
                   lf_phase, lf_length, lf_vals):
     """``K(theta, d, F)`` from maps at the loads ``lf_force`` [N] (increasing): the window
@@ -655,13 +670,8 @@ def advance(n_steps, rec_start, decim, out, j, st, ist, fail,
             if model2 and not conv:
                 # no fixed point: the iterates alternate between the two sides of a contact
                 # zone boundary (a handover inside this step). Keep the side of the first solve.
-                if take_next:
-                    conv = True
-                elif it >= 2 and abs(b2 - b2_m2) <= 1e-3 * tol and res >= tol:
-                    if abs(kk - k_first) <= abs(k_m1 - k_first):
-                        conv = True
-                    else:
-                        take_next = True
+                conv, take_next = no_fixed_point(take_next, it, b2, b2_m2, res, tol, kk, k_first,
+                                                 k_m1)
             if conv:
                 break
             if it >= maxit:

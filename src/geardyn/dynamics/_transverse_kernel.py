@@ -444,14 +444,9 @@ def advance_transverse(n_steps, rec_start, decim, out, j, st, ist, fail,
                     qout += dq5
                     for i in range(nd):
                         w[i] += Sinv[i, 0] * dq0 + Sinv[i, io] * dq5
-            if model2 and not conv:
-                if take_next:
-                    conv = True
-                elif it >= 2 and abs(b2 - b2_m2) <= 1e-3 * tol and res >= tol:
-                    if abs(kk - k_first) <= abs(k_m1 - k_first):
-                        conv = True
-                    else:
-                        take_next = True
+            if model2 and not conv:  # a step without a fixed point (the 6-DOF kernel's rule)
+                conv, take_next = K.no_fixed_point(take_next, it, b2, b2_m2, res, tol, kk,
+                                                   k_first, k_m1)
             if conv:
                 break
             if it >= maxit:

@@ -615,6 +615,7 @@ def model_regimes(out: str | os.PathLike, *, sweep=None, quick: bool = False, ca
                   overrides: Sequence[str] = (), method: str | None = None,
                   workers: int | None = None, scheduler: str | None = None, client=None,
                   force: bool = False, start_evaluation: bool = True, convergence: bool = True,
+                  runup: bool = True,
                   progress: Callable[[str, int, int], None] | None = None):
     r"""Run the study's sweep into ``out`` and return model II against model I-static over it.
 
@@ -635,9 +636,13 @@ def model_regimes(out: str | os.PathLike, *, sweep=None, quick: bool = False, ca
     convergence : bool
         Afterwards run :func:`evaluation_convergence` at the point of the largest ``ratio_max``
         (in this process).
+    runup : bool
+        Also run both models through a run-up across the centre-distance mode
+        (:func:`geardyn.studies.model_runup.runup_comparison` on the base case; variables
+        ``runup_*`` over ``runup_window``).
     progress : callable, optional
         ``progress(stage, done, total)``: stages ``"simulations"`` (runs, counting those
-        already in the store) and ``"time-step check"``.
+        already in the store), ``"time-step check"`` and ``"run-up"``.
 
     Returns
     -------
@@ -690,6 +695,8 @@ def model_regimes(out: str | os.PathLike, *, sweep=None, quick: bool = False, ca
     })
     if convergence:
         ds = _with_convergence(ds, base, progress)
+    if runup:
+        ds = _with_runup(ds, base, progress)
     ds.attrs["run_seconds"] = float(time.perf_counter() - t0)
     return ds
 
@@ -782,4 +789,26 @@ def _with_convergence(ds, base, progress):
     conv = conv.rename({"dt": "convergence_dt", "signal": "convergence_signal"})
     for name in conv.data_vars:
         ds[f"convergence_{name}"] = conv[name]
+    return ds
+
+
+def _with_runup(ds, base, progress):
+    """``ds`` with :func:`geardyn.studies.model_runup.runup_comparison` on the base case."""
+    from .model_runup import runup_comparison
+
+    cb = (lambda d, n: progress("run-up", d, n)) if progress is not None else None
+    if cb is not None:
+        cb(0, 2)
+    try:
+        ru = runup_comparison(base, progress=cb)
+    except GeardynError as exc:
+        ds.attrs["runup_status"] = f"failed: {exc}"
+        return ds
+    ds.attrs["runup_status"] = "ok"
+    for key, val in ru.attrs.items():
+        if key != "title":
+            ds.attrs[f"runup_{key}"] = val
+    ru = ru.rename({"window": "runup_window", "signal": "runup_signal"})
+    for name in ru.data_vars:
+        ds[f"runup_{name}"] = ru[name]
     return ds

@@ -393,6 +393,58 @@ def figure_convergence(ds):
 
 
 # ----------------------------------------------------------------------------- the page
+def runup_summary(ds) -> dict:
+    """The run-up's figures for the page and the CLI (``runup_*`` variables of the study)."""
+    r = ds["runup_ratio_max"].values
+    fr = ds["runup_frequency_ratio"].values
+    k = int(np.nanargmax(r))
+    sig = [str(x) for x in ds["runup_signal"].values]
+    j = int(np.nanargmax(ds["runup_ratio"].values[:, k]))
+    thr = float(ds.attrs.get("threshold", 0.1))
+    above = np.nonzero(r > thr)[0]
+    if above.size:
+        spans, start = [], above[0]
+        for a, b in zip(above[:-1], above[1:], strict=True):
+            if b != a + 1:
+                spans.append((start, a))
+                start = b
+        spans.append((start, above[-1]))
+        text = "mesh frequency " + ", ".join(f"{fr[a]:.2f}-{fr[b]:.2f}" for a, b in spans) \
+            + " times the mode's"
+    else:
+        text = "nowhere"
+    ramp = float(ds.attrs.get("runup_ramp_time", math.nan))
+    return {"max": float(r[k]), "max_ratio": float(fr[k]), "max_signal": sig[j],
+            "above": int(above.size), "windows": int(r.size), "above_text": text,
+            "mode": float(ds.attrs.get("runup_mode_frequency", math.nan)),
+            "start_speed": float(ds.attrs.get("runup_start_speed", math.nan)),
+            "end_speed": float(ds.attrs.get("runup_end_speed", math.nan)),
+            "ramp_time": ramp, "window_time": ramp / max(r.size, 1),
+            "ratio_lo": float(np.nanmin(fr)), "ratio_hi": float(np.nanmax(fr)),
+            "iterating": float(np.nanmax(ds["runup_iterating_steps"].values)),
+            "max_iterations": float(np.nanmax(ds["runup_max_iterations"].values))}
+
+
+def figure_runup(ds):
+    """RMS(II - I-static)/STD(II) per run-up window against the frequency ratio."""
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7.0, 3.6))
+    fr = ds["runup_frequency_ratio"].values
+    for i, sg in enumerate(ds["runup_signal"].values):
+        ax.plot(fr, ds["runup_ratio"].values[i], marker=".", label=str(sg))
+    ax.axhline(float(ds.attrs.get("threshold", 0.1)), color="red", lw=1)
+    for x in (0.5, 1.0):
+        if fr.min() <= x <= fr.max():
+            ax.axvline(x, color="0.4", ls="--", lw=0.8)
+    ax.set_xlabel("mesh frequency / centre-distance mode frequency [-]")
+    ax.set_ylabel("RMS(II - I-static) / STD(II) [-]")
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    return fig
+
+
 def write_report(ds, out, *, command: str = "") -> Path:
     """Write ``model_regimes.html`` and ``figures/*.png`` into ``out``.
 
@@ -554,6 +606,29 @@ def write_report(ds, out, *, command: str = "") -> Path:
         plt.close(fig)
     elif "convergence_status" in ds.attrs:
         rep.note(f"Time-step check: {ds.attrs['convergence_status']}")
+    if ds.attrs.get("runup_status") == "ok":
+        ru = runup_summary(ds)
+        rep.heading("A run-up through the centre-distance mode")
+        rep.paragraph(
+            f"The base case run up from {ru['start_speed']:.3g} to {ru['end_speed']:.3g} rad/s "
+            f"in {ru['ramp_time']:g} s (mesh frequency {ru['ratio_lo']:.2g} to "
+            f"{ru['ratio_hi']:.2g} times the centre-distance mode's {ru['mode']:.4g} Hz), "
+            "with a constant load torque so that the mean mesh load and model I-static's "
+            "static centre distance stay those of the case, and a light speed-controlled "
+            f"drive. Largest RMS(II - I-static)/STD(II) in a {ru['window_time']:.3g} s window: "
+            f"{ru['max']:.3g} ({ru['max_signal']}) at {ru['max_ratio']:.3g} times the mode's "
+            f"frequency; above {100 * s['threshold']:g} % in {ru['above']} of {ru['windows']} "
+            f"windows ({ru['above_text']}). Model II re-solved in {ru['iterating']:.3g} of its "
+            f"steps at most (a window's share), at most {ru['max_iterations']:.0f} re-solves in "
+            "a step.")
+        fig = figure_runup(ds)
+        rep.figure(fig, "runup", "Run-up: RMS(II - I-static)/STD(II) per window against the "
+                                 "mesh frequency over the centre-distance mode's frequency "
+                                 "(dashed: 1 and 1/2), one line per signal; the threshold in "
+                                 "red.")
+        plt.close(fig)
+    elif "runup_status" in ds.attrs:
+        rep.note(f"Run-up: {ds.attrs['runup_status']}")
     rep.heading("Reproduce")
     rep.paragraph(
         f"{'Command: ' + command + '. ' if command else ''}Sweep file: "
