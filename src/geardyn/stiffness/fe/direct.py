@@ -13,6 +13,15 @@ reused except the FE body model itself (mesh and elasticity):
 * the compatibility problem is solved with non-negative multipliers (NNLS on the Cholesky factor
   of the Delassus matrix) and the pinion rotation is found from the torque balance.
 
+Limitation at a loaded tip corner (extended contact beyond the path): the FE teeth have sharp
+tip corners and the flanks meet there at an angle, so the corner's contact zone is narrower than
+the flank elements and the contact is carried by the corner node alone. Its compliance is then
+that of a point load on the mesh, which grows without bound as the mesh is refined (by
+``(2/pi)(1/E_1' + 1/E_2') ln(h_1/h_2)`` per refinement from ``h_1`` to ``h_2``; trap T21 of
+docs/verification/stiffness.md), and it does not depend on the load. So at such positions the
+solve is not a converged reference (docs/verification/stiffness.md, section 3.1). ``node_*``
+of the result show which nodes carry each pair and their compliances.
+
 Linear elasticity with linearised (small-displacement) contact, the same bore conditions as the
 influence route (gear bore fixed, pinion bore rigid and turned by ``Delta theta``).
 
@@ -53,6 +62,18 @@ class DirectResult:
         Slave nodes considered.
     seconds : float
         Wall time of the solve (Delassus matrix and contact problem) [s].
+    node_pair : ndarray of int, optional
+        Pair index ``n`` of each candidate node.
+    node_kind : ndarray of str, optional
+        ``"p"`` pinion flank node (its tip corner included) against the gear flank, ``"g"`` gear
+        tip corner against the pinion flank.
+    node_gap : ndarray, optional
+        Unloaded normal gap of each candidate node, measured on the meshes [m].
+    node_force : ndarray, optional
+        Normal contact force of each candidate node [N/m].
+    node_compliance : ndarray, optional
+        Diagonal of the Delassus matrix: approach of the two bodies at the node per unit force
+        there [m^2/N] (a point load on the mesh).
     """
 
     rotation: float
@@ -60,6 +81,11 @@ class DirectResult:
     n_contact_nodes: int
     n_candidates: int
     seconds: float
+    node_pair: np.ndarray | None = None
+    node_kind: np.ndarray | None = None
+    node_gap: np.ndarray | None = None
+    node_force: np.ndarray | None = None
+    node_compliance: np.ndarray | None = None
 
     def load_share(self) -> dict:
         """Share of the total normal force per pair [-]."""
@@ -271,5 +297,7 @@ def direct_contact(pinion: ElasticBody, gear: ElasticBody, pair, theta: float, d
             pf[int(q)] = pf.get(int(q), 0.0) + float(f)
     return DirectResult(rotation=float(dth), pair_force=pf,
                         n_contact_nodes=int(np.sum(lam > 0)), n_candidates=n,
-                        seconds=time.perf_counter() - t0)
+                        seconds=time.perf_counter() - t0, node_pair=pair_of,
+                        node_kind=np.array([r[0] for r in rows1 + rows2]), node_gap=gap,
+                        node_force=lam, node_compliance=np.diag(W).copy())
 
