@@ -664,6 +664,7 @@ def diagnose(
             "envelope_excludes_carrier": bool(envelope_excludes_carrier),
             "remove_mean_phase": bool(remove_mean_phase),
             "pwvd_max_order": float(max_order),
+            "pwvd_window_length": None if pwvd_window_length is None else int(pwvd_window_length),
             "statistics_conventions": "std ddof=0; skewness g1; kurtosis Pearson (normal=3); "
                                       "crest_factor=max|x-mean|/std; crest_factor_rms=max|x|/rms",
         },

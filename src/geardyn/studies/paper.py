@@ -580,34 +580,25 @@ def diagnostics_stage(case: Case, out: Path, result: StudyResult) -> None:
 
     z = case.pinion.teeth
     cache = default_cache()
-    diags, inputs, keys_of, full = {}, {}, {}, {}
+    diags, inputs, keys_of = {}, {}, {}
     keys = [k for k in result.sims if k[0] in ("I", "II") or k == ("I-static", "cracked")]
-    drawn = (("I", "cracked"), ("II", "cracked"))  # only these are drawn as PWVDs
+    drawn = (("I", "cracked"), ("II", "cracked"))  # the diagnoses the figures show
     for i, key in enumerate(keys):
         result.emit(f"diagnostics: model {key[0]}, {key[1]}", i, len(keys))
         # through the cache, keyed by the record's signals and the settings (issue 16): a run of
         # the same inputs into another folder diagnoses nothing again
         inputs[key] = _diagnosis_inputs(case, result.sims[key])
         keys_of[key] = diagnosis_key(inputs[key])
-        diags[key], computed = cached_diagnosis(inputs[key], keys_of[key], cache)
-        if computed is not None and key in drawn:
-            full[key] = computed  # kept for the figures (their PWVDs)
+        diags[key], _ = cached_diagnosis(inputs[key], keys_of[key], cache)
         result.emit(f"diagnostics: model {key[0]}, {key[1]}", i + 1, len(keys))
     result.diagnoses = diags  # without the PWVD distributions
     cracked = {m: diags[(m, "cracked")] for m in ("I", "II")}
 
-    def cracked_full() -> dict:
-        """The cracked diagnoses with their PWVDs, for a figure the cache does not hold."""
-        from ..diagnostics import diagnose
-
-        for k in drawn:
-            if k not in full:
-                full[k] = diagnose(**inputs[k])
-        return {m: full[(m, "cracked")] for m in ("I", "II")}
-
-    # the figures know the diagnoses by their cache keys and compute them only when drawn
+    # the figures know the diagnoses by their cache keys; the PWVD figures compute the two
+    # distributions they draw when they are drawn (40 MB each: holding all twelve of the two
+    # cracked diagnoses was the peak of a cold run's memory)
     cracked_figs = Deferred(fingerprint("cracked diagnoses", [keys_of[k] for k in drawn]),
-                            cracked_full)
+                            lambda: cracked)
 
     t2, t3 = paper_tables({**cracked, **({"I-static": diags[("I-static", "cracked")]}
                                          if ("I-static", "cracked") in diags else {})})
@@ -659,8 +650,6 @@ def diagnostics_stage(case: Case, out: Path, result: StudyResult) -> None:
                  z, max_order)
         F.cached(f"fig{b}_demodulation_{sig}", pf.fig_demodulation_pair, cracked_figs, sig)
         F.cached(f"fig{c}_analytic_{sig}", pf.fig_analytic_pair, cracked_figs, sig)
-    # the figures are rendered: the time-frequency distributions (tens of MB per signal and
-    # run), which no later stage reads, are dropped with ``full``
 
 
 def _without_distributions(diag):

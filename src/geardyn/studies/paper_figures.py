@@ -225,6 +225,16 @@ def fig_residuals(diags: dict) -> Figure:
     return _grid(lambda s, m: f"model {m}: residual of {SIGNALS[s][0]}", plot, diags)
 
 
+def _pwvd_again(diag, sd, which: str):
+    """The PWVD :func:`geardyn.diagnostics.diagnose` computed for ``sd`` (same input and
+    settings, so the same numbers), for a diagnosis stored without its distributions."""
+    from ..diagnostics.tfd import pwvd
+
+    x = sd.tsa.average if which == "tsa" else sd.residual
+    return pwvd(x, window_length=diag.settings.get("pwvd_window_length"),
+                max_order=diag.settings["pwvd_max_order"])
+
+
 def fig_pwvd_pair(diags: dict, sig: str, which: str, teeth: int, max_order: float) -> Figure:
     """Figs. 14/15/18/21 analogues: PWVD of the TSA (``which="tsa"``) or of the residual."""
     fig = _new_figure(figsize=(11.0, 4.3), layout="constrained")
@@ -232,6 +242,8 @@ def fig_pwvd_pair(diags: dict, sig: str, which: str, teeth: int, max_order: floa
     for ax, m in zip(axs, MODELS, strict=True):
         sd = diags[m].signals[sig]
         pw = sd.pwvd_tsa if which == "tsa" else sd.pwvd_residual
+        if pw.distribution.size == 0:  # a diagnosis kept without its distributions (memory):
+            pw = _pwvd_again(diags[m], sd, which)  # the same PWVD, computed for this figure
         k = pw.orders <= max_order
         n_ang = pw.angle.size
         d = pw.distribution[:, k] if pw.distribution.shape[0] == n_ang else \

@@ -152,6 +152,10 @@ def load_roll_lengths(gear, n: int, tip_radius: float | None = None) -> np.ndarr
     return u_lo + (u_tip - u_lo) * (1 - (1 - xi) ** 1.5)
 
 
+#: Load columns solved and read out together by :func:`influence_matrices`.
+LOAD_CHUNK = 8
+
+
 class ElasticBody:
     """A gear body ready to solve: P2 basis, stiffness matrix, bore fixed, one factorisation.
 
@@ -435,8 +439,13 @@ def influence_matrices(body: ElasticBody, u: np.ndarray, half_width: float, *,
     readouts = sp.vstack([body.readout(j, grids[j]) for j in read]).tocsr()
     H = np.empty((len(load_offsets), len(read), u.size, u.size))
     for a, i in enumerate(load_offsets):
-        X = body.solve(body.patch_loads(i, grids[i], half_width))
-        H[a] = (readouts @ X).reshape(len(read), u.size, u.size)
+        # a few load columns at a time: the dense loads and displacements (n_dofs x columns,
+        # 57 MB each for 48 columns of the paper's body) stay small; every column is its own
+        # patch and solve, so the coefficients are the same bit for bit
+        for c0 in range(0, u.size, LOAD_CHUNK):
+            cols = slice(c0, min(c0 + LOAD_CHUNK, u.size))
+            X = body.solve(body.patch_loads(i, grids[i][cols], half_width))
+            H[a, :, :, cols] = (readouts @ X).reshape(len(read), u.size, -1)
         if progress is not None:
             progress(a + 1, len(load_offsets))
     stats = {"nodes": body.mesh.n_nodes, "triangles": body.mesh.n_triangles,
