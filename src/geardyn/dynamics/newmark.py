@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -521,12 +522,39 @@ def simulate(case, stiffness_map: StiffnessMap | None = None, *, model: str | No
 
     family = build_load_family(case, cracked=cracked)  # None unless stiffness.fe.torques
     sim = case.simulation
+    with case_arithmetic(case):
+        dyn = DynamicModel.from_case(case, stiffness_map)
+        check_time_step(dyn, stiffness_map, sim.dt)
+        static = static_equilibrium(dyn, stiffness_map, which=which)
+        setup = _setup_for_case(case, dyn, stiffness_map, which, static, family)
+    n_settle, decim, count, n_last = record_plan(sim)
+    out = np.full((count, K.N_REC), np.nan)
+    st, ist = initial_state(setup, _start_with_errors(setup, dyn, static))
+    rows = [0]
+
+    def step(n: int):
+        # the first call also records the initial state when nothing is settled
+        status, rows[0], fail = run_steps(setup, st, ist, n, rec_start=n_settle, decim=decim,
+                                          out=out, j=rows[0])
+        return status, fail
+
+    def record(complete: bool):
+        return _dataset(case, dyn, stiffness_map, which, static, setup, out[:rows[0]], n_settle,
+                        decim, complete=complete)
+
+    status, fail = drive_chunks(step, ist, n_last, progress=progress)
+    if status != K.OK:
+        raise_with_partial(status, fail, which, static, stiffness_map, record)
+    return record(True)
+
+
+@contextmanager
+def case_arithmetic(case):
+    """Run the model set-up of ``case``: floating-point overflow, a singular matrix or a value
+    error become an :class:`InputError` naming the case's extreme fields."""
     try:
         with np.errstate(over="raise", invalid="raise", divide="raise"):
-            dyn = DynamicModel.from_case(case, stiffness_map)
-            check_time_step(dyn, stiffness_map, sim.dt)
-            static = static_equilibrium(dyn, stiffness_map, which=which)
-            setup = _setup_for_case(case, dyn, stiffness_map, which, static, family)
+            yield
     except GeardynError:
         raise
     except (FloatingPointError, OverflowError, ZeroDivisionError, ValueError,
@@ -535,40 +563,47 @@ def simulate(case, stiffness_map: StiffnessMap | None = None, *, model: str | No
         raise InputError(", ".join(fields) or "case", "values whose products overflow or are "
                          f"singular ({exc})", "physical magnitudes: the model's matrices and "
                          "static equilibrium must stay finite") from None
+
+
+def record_plan(sim) -> tuple[int, int, int, int]:
+    """``(n_settle, decimation, records, n_last)`` of ``case.simulation`` (refused when the
+    record would not fit, :func:`_check_record_size`)."""
     dt = sim.dt
     n_settle = int(round(sim.settle_time / dt))
     n_record = max(1, int(round(sim.record_time / dt)))
     decim = sim.decimation
     count = -(-n_record // decim)
-    n_last = n_settle + (count - 1) * decim
     _check_record_size(count, sim)
-    out = np.full((count, K.N_REC), np.nan)
-    st, ist = initial_state(setup, _start_with_errors(setup, dyn, static))
-    j = 0
-    done = 0
+    return n_settle, decim, count, n_settle + (count - 1) * decim
+
+
+def drive_chunks(step: Callable[[int], tuple], ist: np.ndarray, n_last: int, *,
+                 chunk: int = CHUNK_STEPS,
+                 progress: Callable[[int, int], None] | None = None) -> tuple:
+    """Call ``step(n) -> (status, fail)`` on chunks of at most ``chunk`` steps until step
+    ``n_last`` (the count in ``ist[0]``) or a failure; ``progress(done, n_last)`` between
+    chunks. Returns the last ``(status, fail)``."""
     if progress is not None:
         progress(0, n_last)
     while True:
-        # the first call also records the initial state when nothing is settled
-        n = min(CHUNK_STEPS, n_last - done)
-        status, j, fail = run_steps(setup, st, ist, n, rec_start=n_settle, decim=decim, out=out,
-                                    j=j)
-        done = int(ist[0])
+        status, fail = step(min(chunk, n_last - int(ist[0])))
         if progress is not None:
-            progress(done, n_last)
-        if status != K.OK:
-            if which == "I-static":  # the kernel's change is from the shifted d0
-                fail[5] += static.centre_distance_change
-            ds = _dataset(case, dyn, stiffness_map, which, static, setup, out[:j], n_settle,
-                          decim, complete=False)
-            exc = _numerical_error(status, fail, stiffness_map, which)
-            ds.attrs["failure"] = str(exc)
-            exc.partial = ds
-            raise exc
-        if done >= n_last:
-            break
-    return _dataset(case, dyn, stiffness_map, which, static, setup, out[:j], n_settle, decim,
-                    complete=True)
+            progress(int(ist[0]), n_last)
+        if status != K.OK or int(ist[0]) >= n_last:
+            return status, fail
+
+
+def raise_with_partial(status: int, fail: np.ndarray, which: str, static: StaticState,
+                       stiffness_map: StiffnessMap, record: Callable[[bool], object]):
+    """Raise the :class:`NumericalError` of a failed run with the record up to the failure
+    attached as ``exc.partial`` (attribute ``complete = 0``)."""
+    if which == "I-static":  # the kernel's change is from the shifted d0
+        fail[5] += static.centre_distance_change
+    ds = record(False)
+    exc = _numerical_error(status, fail, stiffness_map, which)
+    ds.attrs["failure"] = str(exc)
+    exc.partial = ds
+    raise exc
 
 
 def _extreme_fields(case) -> list[str]:

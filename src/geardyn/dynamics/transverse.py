@@ -73,7 +73,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import GeardynError, InputError
+from ..errors import InputError
 from ..stiffness.map import MapArrays, StiffnessMap
 from . import _kernel as K
 from . import _transverse_kernel as T
@@ -523,10 +523,12 @@ def simulate_transverse(case, stiffness_map: StiffnessMap | None = None, *,
     from .model import MODELS
     from .newmark import (
         CHUNK_STEPS,
-        _check_record_size,
-        _extreme_fields,
-        _numerical_error,
+        _start_with_errors,
+        case_arithmetic,
         check_bounded_work,
+        drive_chunks,
+        raise_with_partial,
+        record_plan,
     )
 
     which = case.simulation.model if model is None else model
@@ -539,59 +541,33 @@ def simulate_transverse(case, stiffness_map: StiffnessMap | None = None, *,
 
         stiffness_map = build_map(case, cracked=cracked)
     sim = case.simulation
-    try:
-        with np.errstate(over="raise", invalid="raise", divide="raise"):
-            tm = TransverseModel.from_case(case, stiffness_map, x_free=x_free)
-            check_time_step(tm.base, stiffness_map, sim.dt)
-            _check_x_modes(tm, sim.dt)
-            static = static_equilibrium(tm.base, stiffness_map, which=which)
-            setup = make_transverse_setup(case, tm, stiffness_map, which, static)
-    except GeardynError:
-        raise
-    except (FloatingPointError, OverflowError, ZeroDivisionError, ValueError,
-            np.linalg.LinAlgError) as exc:
-        fields = _extreme_fields(case)
-        raise InputError(", ".join(fields) or "case", "values whose products overflow or are "
-                         f"singular ({exc})", "physical magnitudes: the model's matrices and "
-                         "static equilibrium must stay finite") from None
-    dt = sim.dt
-    n_settle = int(round(sim.settle_time / dt))
-    n_record = max(1, int(round(sim.record_time / dt)))
-    decim = sim.decimation
-    count = -(-n_record // decim)
-    n_last = n_settle + (count - 1) * decim
-    _check_record_size(count, sim)
-    nd = setup.nd
-    out = np.full((count, T.record_layout(nd)[3]), np.nan)
-    from .newmark import _start_with_errors
-
+    with case_arithmetic(case):
+        tm = TransverseModel.from_case(case, stiffness_map, x_free=x_free)
+        check_time_step(tm.base, stiffness_map, sim.dt)
+        _check_x_modes(tm, sim.dt)
+        static = static_equilibrium(tm.base, stiffness_map, which=which)
+        setup = make_transverse_setup(case, tm, stiffness_map, which, static)
+    n_settle, decim, count, n_last = record_plan(sim)
+    out = np.full((count, T.record_layout(setup.nd)[3]), np.nan)
     st, ist = initial_transverse_state(setup, tm.embed(
         _start_with_errors(setup.base_setup, tm.base, static)))
-    j = 0
-    done = 0
-    if progress is not None:
-        progress(0, n_last)
-    chunk = CHUNK_STEPS if not python else 2000
-    while True:
-        n = min(chunk, n_last - done)
-        status, j, fail = run_transverse_steps(setup, st, ist, n, rec_start=n_settle,
-                                               decim=decim, out=out, j=j, python=python)
-        done = int(ist[0])
-        if progress is not None:
-            progress(done, n_last)
-        if status != K.OK:
-            if which == "I-static":
-                fail[5] += static.centre_distance_change
-            ds = transverse_dataset(case, setup, stiffness_map, which, static, out[:j],
-                                    n_settle, decim, complete=False)
-            exc = _numerical_error(status, fail, stiffness_map, which)
-            ds.attrs["failure"] = str(exc)
-            exc.partial = ds
-            raise exc
-        if done >= n_last:
-            break
-    return transverse_dataset(case, setup, stiffness_map, which, static, out[:j], n_settle,
-                              decim, complete=True)
+    rows = [0]
+
+    def step(n: int):
+        status, rows[0], fail = run_transverse_steps(setup, st, ist, n, rec_start=n_settle,
+                                                     decim=decim, out=out, j=rows[0],
+                                                     python=python)
+        return status, fail
+
+    def record(complete: bool):
+        return transverse_dataset(case, setup, stiffness_map, which, static, out[:rows[0]],
+                                  n_settle, decim, complete=complete)
+
+    status, fail = drive_chunks(step, ist, n_last, chunk=CHUNK_STEPS if not python else 2000,
+                                progress=progress)
+    if status != K.OK:
+        raise_with_partial(status, fail, which, static, stiffness_map, record)
+    return record(True)
 
 
 def _check_x_modes(tm: TransverseModel, dt: float) -> None:
