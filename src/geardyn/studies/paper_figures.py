@@ -248,14 +248,16 @@ def fig_pwvd_pair(diags: dict, sig: str, which: str, teeth: int, max_order: floa
         n_ang = pw.angle.size
         d = pw.distribution[:, k] if pw.distribution.shape[0] == n_ang else \
             pw.distribution[k, :].T
-        # cell edges: angle bins tile 0..360 deg exactly (no blank strip at 360 deg)
-        ang_edges = np.arange(n_ang + 1) * 360.0 / n_ang
+        # cells on a uniform grid: angle bins tile 0..360 deg exactly (no blank strip at
+        # 360 deg), order bins centred on their orders; drawn as an image (a quad mesh of
+        # millions of cells took 0.9 s per figure, most of the run's figure time)
         o = pw.orders[k]
         step = o[1] - o[0] if o.size > 1 else 1.0
-        order_edges = np.concatenate([o - step / 2, [o[-1] + step / 2]])
         vmax = np.max(np.abs(d)) or 1.0
-        im = ax.pcolormesh(ang_edges, np.maximum(order_edges, 0.0), d.T, shading="flat",
-                           cmap="viridis", vmin=0, vmax=vmax, rasterized=True)
+        im = ax.imshow(d.T, origin="lower", aspect="auto", interpolation="nearest",
+                       extent=(0.0, 360.0, o[0] - step / 2, o[-1] + step / 2),
+                       cmap="viridis", vmin=0, vmax=vmax)
+        ax.set_ylim(max(o[0] - step / 2, 0.0), o[-1] + step / 2)
         for h in range(teeth, int(max_order) + 1, teeth):
             ax.axhline(h, color="w", ls=":", lw=0.5, alpha=0.6)
         ax.set_title(f"model {m}: PWVD of the {'TSA' if which == 'tsa' else 'residual'} of "
