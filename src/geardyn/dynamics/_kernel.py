@@ -372,6 +372,33 @@ def _excite(th, tha, b1, rsum, dd, pfree, sep, eip, efp, etp, etg, els,
 
 
 @numba.njit(cache=True, nogil=True, fastmath=False)
+def update_small(an, ap, M, force_scale, rtol):
+    """Whether the acceleration update of a re-solve is small in the mass norm:
+    ``|an - ap|_M <= rtol max(|an|_M, force_scale)`` (``force_scale`` the mesh force's
+    ``(1+alpha) |N u|_M``)."""
+    n = an.shape[0]
+    da = 0.0
+    aa = 0.0
+    for i in range(n):
+        for k in range(n):
+            da += (an[i] - ap[i]) * M[i, k] * (an[k] - ap[k])
+            aa += an[i] * M[i, k] * an[k]
+    return not da > rtol * rtol * max(aa, force_scale ** 2)
+
+
+def two_cycle_py(take_next, it, history_b2, history_k, res, tol):
+    """The twins' copy of :func:`no_fixed_point` over their iterate histories (written on
+    lists, independently of the kernels): ``(accept, take_next)``."""
+    if take_next:
+        return True, take_next
+    if it >= 2 and abs(history_b2[-1] - history_b2[-3]) <= 1e-3 * tol and res >= tol:
+        if abs(history_k[-1] - history_k[0]) <= abs(history_k[-2] - history_k[0]):
+            return True, take_next
+        return False, True
+    return False, take_next
+
+
+@numba.njit(cache=True, nogil=True, fastmath=False)
 def no_fixed_point(take_next, it, b2, b2_m2, res, tol, kk, k_first, k_m1):
     """Model II's rule for a step without a fixed point (module text): the iterates settle into
     a two-cycle across a contact zone boundary (``|b2_m - b2_{m-2}| <= 1e-3 tol`` while
@@ -642,16 +669,8 @@ def advance(n_steps, rec_start, decim, out, j, st, ist, fail,
                     res_b = res
                 if not res < tol:
                     conv = False
-            if it > 0:
-                da = 0.0
-                aa = 0.0
-                for i in range(6):
-                    for k in range(6):
-                        da += (an[i] - ap[i]) * M[i, k] * (an[k] - ap[k])
-                        aa += an[i] * M[i, k] * an[k]
-                sc = max(aa, (opa * nf * unorm) ** 2)
-                if da > rtol * rtol * sc:
-                    conv = False
+            if it > 0 and not update_small(an, ap, M, opa * nf * unorm, rtol):
+                conv = False
             if in_nl or out_nl:
                 dq0 = 0.0
                 dq5 = 0.0
@@ -977,13 +996,7 @@ def advance_python(n_steps, rec_start, decim, out, j, st, ist, fail,
             history_b2.append(b2)
             history_k.append(kk)
             if model2 and not conv:     # a two-cycle across a zone boundary: see the kernel
-                if take_next:
-                    conv = True
-                elif it >= 2 and abs(b2 - history_b2[-3]) <= 1e-3 * tol and res >= tol:
-                    if abs(kk - history_k[0]) <= abs(history_k[-2] - history_k[0]):
-                        conv = True
-                    else:
-                        take_next = True
+                conv, take_next = two_cycle_py(take_next, it, history_b2, history_k, res, tol)
             if conv:
                 break
             if it >= maxit:

@@ -421,16 +421,8 @@ def advance_transverse(n_steps, rec_start, decim, out, j, st, ist, fail,
                     conv = False
             if xfree and not abs(phin - phi) * t1t2 < tol:
                 conv = False
-            if it > 0:
-                da = 0.0
-                aa = 0.0
-                for i in range(nd):
-                    for k in range(nd):
-                        da += (an[i] - ap[i]) * M[i, k] * (an[k] - ap[k])
-                        aa += an[i] * M[i, k] * an[k]
-                sc = max(aa, (nf * tfp[TF_UNORM]) ** 2)
-                if da > rtol * rtol * sc:
-                    conv = False
+            if it > 0 and not K.update_small(an, ap, M, nf * tfp[TF_UNORM], rtol):
+                conv = False
             if in_nl or out_nl:
                 dq0 = 0.0
                 dq5 = 0.0

@@ -216,14 +216,8 @@ def advance_transverse_python(n_steps, rec_start, decim, out, j, st, ist, fail,
                     load[io] += dq5
             history_b2.append(b2)
             history_k.append(kk)
-            if model2 and not conv:
-                if take_next:
-                    conv = True
-                elif it >= 2 and abs(b2 - history_b2[-3]) <= 1e-3 * tol and res >= tol:
-                    if abs(kk - history_k[0]) <= abs(history_k[-2] - history_k[0]):
-                        conv = True
-                    else:
-                        take_next = True
+            if model2 and not conv:  # the 6-DOF twin's rule for a step without a fixed point
+                conv, take_next = K.two_cycle_py(take_next, it, history_b2, history_k, res, tol)
             if conv:
                 break
             if it >= maxit:
