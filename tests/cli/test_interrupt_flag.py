@@ -70,3 +70,37 @@ def test_an_interrupt_swallowed_by_a_ctypes_callback_prints_no_traceback(capsys)
     assert exc.value.exit_code == 130 and ticks == ["after the callback"]
     assert "Traceback" not in err and "Exception ignored" not in err
     assert "interrupted" in err
+
+
+def test_a_ctrl_c_that_an_import_turned_into_a_type_error_still_exits_130(capsys, monkeypatch):
+    """A Ctrl-C landing while Python builds a failing import's ImportError comes out as
+    ``TypeError: expected a message argument`` (seen in CI during the PEM map's imports). With a
+    Ctrl-C pending, the command reports the interruption, not an internal error."""
+
+    @C.handle_errors
+    def command():
+        try:
+            signal.raise_signal(signal.SIGINT)
+        except KeyboardInterrupt:  # what CPython's import machinery did with it
+            raise TypeError("expected a message argument") from None
+
+    monkeypatch.delenv("GEARDYN_DEBUG", raising=False)
+    with pytest.raises(typer.Exit) as exc:
+        command()
+    err = capsys.readouterr().err
+    assert exc.value.exit_code == 130
+    assert "interrupted" in err and "internal error" not in err
+
+
+def test_a_type_error_without_a_ctrl_c_is_still_an_internal_error(capsys, monkeypatch):
+    """The mutant guard for the test above: the rule is keyed on the pending Ctrl-C only."""
+
+    @C.handle_errors
+    def command():
+        raise TypeError("expected a message argument")
+
+    monkeypatch.delenv("GEARDYN_DEBUG", raising=False)
+    with pytest.raises(typer.Exit) as exc:
+        command()
+    assert exc.value.exit_code == 1
+    assert "internal error" in capsys.readouterr().err

@@ -3,7 +3,7 @@
 Every command takes ``--config FILE`` and repeatable ``--set dotted.key=value``. Errors a user can
 cause (:class:`geardyn.errors.GeardynError`) print one line (at most :data:`MAX_ERROR_CHARS`
 characters) naming the field, the value and what is allowed, and exit with status 2; Ctrl-C
-exits with 130; nothing prints a traceback unless ``GEARDYN_DEBUG=1``.
+exits with 130 (see :func:`_say_interrupted`); nothing prints a traceback unless ``GEARDYN_DEBUG=1``.
 """
 
 from __future__ import annotations
@@ -124,6 +124,19 @@ def raise_pending_interrupt() -> None:
         raise KeyboardInterrupt
 
 
+def _say_interrupted() -> None:
+    """Print the interruption line and exit with status 130.
+
+    If the Ctrl-C landed while Python ran ``exec`` on a string (``dataclasses`` does this when a
+    module defines a dataclass, so it happens during imports), CPython remembers an "unhandled"
+    KeyboardInterrupt and, after a clean shutdown, ends the process by SIGINT instead of with
+    status 130. A shell reports both as ``$? = 130``; a parent process sees return code -2.
+    """
+    err_console.print("[yellow]interrupted[/yellow]: finished results and caches are "
+                      "kept; re-run the same command to continue.", soft_wrap=True)
+    raise typer.Exit(130) from None
+
+
 def handle_errors(fn: F) -> F:
     """Turn geardyn errors into one clear line and exit code 2 (130 on Ctrl-C)."""
 
@@ -149,10 +162,13 @@ def handle_errors(fn: F) -> F:
                               highlight=False, soft_wrap=True)
             raise typer.Exit(2) from None
         except KeyboardInterrupt:
-            err_console.print("[yellow]interrupted[/yellow]: finished results and caches are "
-                              "kept; re-run the same command to continue.", soft_wrap=True)
-            raise typer.Exit(130) from None
+            _say_interrupted()
         except Exception as exc:  # a bug: say so briefly, keep the traceback for GEARDYN_DEBUG
+            if _INTERRUPT["pending"]:
+                # a Ctrl-C that landed inside an import which was failing anyway comes out as
+                # CPython's "TypeError: expected a message argument" (the ImportError's message
+                # could not be built with the interrupt pending): still the user's Ctrl-C
+                _say_interrupted()
             if os.environ.get("GEARDYN_DEBUG"):
                 raise
             text = one_line(f"{type(exc).__name__}: {exc}", MAX_ERROR_CHARS - 90)
