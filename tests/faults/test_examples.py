@@ -78,3 +78,29 @@ def test_sweep_over_spall_width(tmp_path):
     np.testing.assert_allclose(ds["faults.0.width"].values, [0, 4e-3, 8e-3, 12e-3])
     for metric in ("v_yg__EnergyRatio", "v_yg__FM0", "v_yg__peak_to_peak"):
         assert np.all(np.diff(ds[metric].values) > 0), (metric, ds[metric].values)
+
+
+@pytest.mark.slow
+def test_sweep_over_crack_depth_with_the_substructured_fe_map(tmp_path):
+    """The FE crack-depth sweep (``stiffness.fe.substructure = true``) on a coarser mesh: every
+    run ok, the healthy part condensed once for all depths (one superelement in the cache), and
+    the energy ratio and FM0 of the gear bearing's velocity grow with the depth."""
+    from geardyn.studies.sweep import open_sweep
+
+    store = tmp_path / "depth.zarr"
+    r = _run(["sweep", str(EXAMPLES / "sweep_crack_depth_fe.toml"), "--out", str(store),
+              "--set", "stiffness.fe.refinement=0.5"], tmp_path, timeout=900)
+    assert r.returncode == 0, r.stderr
+    ds = open_sweep(store).load()
+    assert np.all(ds.status.values == 1)
+    np.testing.assert_allclose(ds["crack.depth"].values, np.array([0.5, 1, 2, 3, 4, 5]) * 1e-3)
+    for metric in ("v_yg__EnergyRatio", "v_yg__FM0"):
+        assert np.all(np.diff(ds[metric].values) > 0), (metric, ds[metric].values)
+    fe_entries = [p for p in (tmp_path / "cache" / "fe").glob("*.npz")]
+    with_s = []
+    for p in fe_entries:
+        with np.load(p, allow_pickle=False) as d:
+            with_s.append("S" in d.files)
+    # one healthy body (the paper's 23/23 pinion and gear share it), one superelement, six
+    # cracked bodies
+    assert sum(with_s) == 1 and len(fe_entries) == 1 + 1 + 6, (sum(with_s), len(fe_entries))

@@ -65,6 +65,8 @@ def map_inputs(case, method: str, cracked: bool) -> dict:
         fe = case.stiffness.fe.model_dump(mode="json")
         fe["torque"] = fe_torque(case)  # the resolved load: omitted = motor.torque
         fe.pop("torques", None)  # a load family is several maps, each keyed by its torque
+        if not (cracked and fe.get("substructure")):  # the default keeps earlier keys; a
+            fe.pop("substructure", None)              # healthy map has no faulty body
         if fe["definition"] == "secant":  # the default keeps the keys of earlier secant maps
             del fe["definition"]
         else:

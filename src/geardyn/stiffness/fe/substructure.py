@@ -58,7 +58,7 @@ from .mesh import (
     loaded_flank,
     tooth_offsets,
 )
-from .solve import BodyInfluence, ElasticBody, ElasticMaterial
+from .solve import BodyInfluence, ElasticBody, ElasticMaterial, _isfloat
 
 __all__ = ["build_part_mesh", "glue_meshes", "HealthySuperelement", "interface_radius"]
 
@@ -406,8 +406,12 @@ class HealthySuperelement:
     ----------
     S : ndarray, shape (n_g, n_g)
         Condensed stiffness of ``H`` on ``Gamma`` [N/m per m of width].
+    offsets : tuple of int
+        ``H``'s refined teeth.
     stats : dict
         DOFs and seconds (``t_mesh``, ``t_condense``).
+    mesh, body : BodyMesh, ElasticBody or None
+        ``H``'s mesh and body (``None`` after :meth:`load`).
     """
 
     def __init__(self, gear: Gear, material: ElasticMaterial, settings: MeshSettings,
@@ -423,6 +427,9 @@ class HealthySuperelement:
         t0 = time.perf_counter()
         self.gear, self.material, self.settings = gear, material, settings
         self.n_points, self.fraction = n_points, fraction
+        self.H0 = None
+        #: the cache key this superelement was stored under ("" when built directly)
+        self.inputs_hash = ""
         self.u = u.copy()
         self.half_width = float(half_width)
         self.mesh = build_part_mesh(gear, settings, "H", n_points=n_points, fraction=fraction)
@@ -457,9 +464,53 @@ class HealthySuperelement:
         self.DX = D[:, self.gamma] - d_i @ x[:, :ng]
         #: readouts of H's teeth under H's own loads with Gamma clamped [m^2/N]
         self.DY = d_i @ x[:, ng:]
+        #: H's refined teeth (model tooth offsets; tooth 0 lies in R)
+        self.offsets = tuple(int(j) for j in teeth)
         self.stats = {"nodes_H": self.mesh.n_nodes, "dofs_H": body.n_dofs,
                       "gamma_dofs": int(ng), "t_mesh_H": t_mesh,
                       "t_condense_H": time.perf_counter() - t0 - t_mesh}
+
+    _ARRAYS = ("S", "G", "DX", "DY", "gamma_x", "gamma_c", "u")
+
+    def reference(self) -> np.ndarray:
+        """Influence coefficients ``H`` of the unfaulted glued body ``H + R`` [m^2/N], loaded on
+        every refined tooth (:meth:`influence` without a fault); computed once, kept (and stored
+        by :meth:`save`). A fault's change of ``H`` is its :meth:`influence` minus this."""
+        if getattr(self, "H0", None) is None:
+            self.H0 = self.influence()[0].H
+        return self.H0
+
+    def save(self, path) -> None:
+        """Write the condensed arrays to ``.npz`` (no pickle; not the mesh of ``H``)."""
+        stats = np.array([[k, repr(v)] for k, v in self.stats.items()], dtype=str)
+        with open(path, "wb") as fh:
+            np.savez(fh, **{k: getattr(self, k) for k in self._ARRAYS},
+                     n_gamma=np.int64(self.gamma.size), offsets=np.asarray(self.offsets),
+                     half_width=self.half_width, n_points=np.int64(self.n_points),
+                     fraction=self.fraction, stats=stats, inputs_hash=np.array(self.inputs_hash),
+                     **({} if getattr(self, "H0", None) is None else {"H0": self.H0}))
+
+    @classmethod
+    def load(cls, path, gear: Gear, material: ElasticMaterial,
+             settings: MeshSettings) -> HealthySuperelement:
+        """Read a file written by :meth:`save` for ``gear``, ``material`` and ``settings`` (the
+        caller's cache key vouches that they are the ones it was built with). The mesh and body
+        of ``H`` are not stored: ``mesh`` and ``body`` are ``None``."""
+        self = cls.__new__(cls)
+        with np.load(path, allow_pickle=False) as d:
+            for k in cls._ARRAYS:
+                setattr(self, k, d[k].copy())
+            self.gamma = np.arange(int(d["n_gamma"]))  # only its size is used by influence()
+            self.offsets = tuple(int(v) for v in d["offsets"])
+            self.half_width = float(d["half_width"])
+            self.n_points = int(d["n_points"])
+            self.fraction = float(d["fraction"])
+            self.stats = {str(k): float(v) if _isfloat(v) else str(v) for k, v in d["stats"]}
+            self.inputs_hash = str(d["inputs_hash"])
+            self.H0 = d["H0"].copy() if "H0" in d.files else None
+        self.gear, self.material, self.settings = gear, material, settings
+        self.mesh = self.body = None
+        return self
 
     def influence(self, *, crack: CrackGeometry | None = None,
                   cut_radius: float | None = None, load_offsets: tuple[int, ...] | None = None,
@@ -509,7 +560,7 @@ class HealthySuperelement:
         lu = splu(K, permc_spec="MMD_AT_PLUS_A", options={"SymmetricMode": True})
         t_factor = time.perf_counter() - t0 - t_mesh
 
-        teeth_h = self.mesh.offsets
+        teeth_h = self.offsets
         offsets = tuple(sorted(set(teeth_h) | set(rmesh.offsets)))
         loads = offsets if load_offsets is None else tuple(load_offsets)
         for i in loads:
