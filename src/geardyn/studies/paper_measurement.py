@@ -45,8 +45,8 @@ from .paper_result import StudyResult
 from .paper_values import CONDITION_METRICS
 
 __all__ = ["DEFAULT_ERRORS", "DEFAULT_ERRORS_SOURCE", "VARIANTS", "INDICATORS",
-           "measurement_stage", "measured_indicators", "drivers", "detections",
-           "MEASUREMENT_CACHE_VERSION"]
+           "HOUSING_DAMPING", "measurement_stage", "measured_indicators", "drivers",
+           "detections", "housing_damping_sweep", "MEASUREMENT_CACHE_VERSION"]
 
 #: Tooth errors of the realistic record when the case has none: ISO 1328-1:2013 flank
 #: tolerance class 6 on both gears (the issue's proposed default), drawn with the seeds of
@@ -76,7 +76,14 @@ INDICATORS = (
 )
 
 #: Bump when the stage's results change meaning, so cached results are recomputed.
-MEASUREMENT_CACHE_VERSION = "2"
+MEASUREMENT_CACHE_VERSION = "3"
+
+#: Damping ratios of the housing modes [-] over which the realistic record's indicators are
+#: recomputed (every mode of the case's modal path set to each): how much of a healthy
+#: indicator the transfer path makes (``docs/verification/measurement.md``).
+HOUSING_DAMPING = (0.005, 0.01, 0.02, 0.05, 0.1)
+#: Indicators recomputed over :data:`HOUSING_DAMPING`.
+HOUSING_INDICATORS = ("FM4", "NA4star", "EnergyRatio")
 
 #: A change of an indicator by less than this factor either way is "no change" [-].
 UNCHANGED_FACTOR = 1.1
@@ -229,6 +236,9 @@ def _compute(case: Case, sim_case: Case, result: StudyResult, model: str,
                                    "acc_rms_m_s2": float(np.std(m.acc)),
                                    "noise_rms_m_s2": float(m.noise_rms),
                                    "fs_Hz": float(m.fs)}
+    housing = housing_damping_sweep(
+        case, {state: (c, ds, result.maps[state])
+               for (has_err, state), (c, ds) in records.items() if has_err}, z, tick)
     out_var: dict = {}
     for name in VARIANTS:
         v0 = central_moment(residual(tsas[(name, "healthy")], teeth=z, preset="zakrajsek"), 2)
@@ -250,8 +260,86 @@ def _compute(case: Case, sim_case: Case, result: StudyResult, model: str,
         "variants": {name: {"errors": e, "noise": n} for name, (e, n) in VARIANTS.items()},
         "indicators": out_var,
         "records": {f"{name}|{state}": v for (name, state), v in info.items()},
+        "housing_damping": housing,
         "tsa": {f"{name}|{state}": [float(x) for x in a] for (name, state), a in tsas.items()},
     }
+
+
+def housing_damping_sweep(case: Case, records: dict, teeth: int,
+                          tick: Callable[[str], None] = lambda item: None) -> dict:
+    """The realistic record's indicators with every housing mode's damping ratio set to each of
+    :data:`HOUSING_DAMPING` (same forces, errors, noise settings and tachometer).
+
+    Parameters
+    ----------
+    case : Case
+        Its ``[measurement]`` chain (a modal path; a measured FRF table has no damping to vary).
+    records : dict
+        ``state -> (case with errors, simulation Dataset, stiffness map)``, ``state`` in
+        ``"healthy"``, ``"cracked"``.
+    teeth : int
+        Teeth of the averaged gear.
+
+    Returns
+    -------
+    dict
+        ``damping_ratios`` [-], ``case_damping_ratios`` [-], ``mode_frequencies_Hz``,
+        ``mesh_period_s`` (mean speed of the healthy record), ``decay_over_mesh_period`` (the
+        lowest mode's decay time ``1 / (zeta 2 pi f)`` over the mesh period [-]) and
+        ``healthy`` / ``cracked``: indicator -> list over the damping ratios (NaN where the
+        record is too short for the path's memory at that damping, the reason under
+        ``not_computed``); or ``skipped``.
+    """
+    from ..config import MeasurementConfig
+    from ..diagnostics import tach_pulse_times, tsa
+    from ..diagnostics.metrics import central_moment
+    from ..diagnostics.spectra import residual
+    from ..errors import GeardynError
+    from .measure import chain_from_config, housing_forces
+
+    cfg = case.measurement if case.measurement is not None else MeasurementConfig()
+    if cfg.frf_table is not None:
+        return {"skipped": "the transfer path is a measured FRF table (no modal damping to vary)"}
+    d = case.diagnostics
+    freqs = [float(f) for f in cfg.mode_frequencies]
+    forces = {state: housing_forces(c, m, ds) for state, (c, ds, m) in records.items()}
+    out: dict = {"damping_ratios": list(HOUSING_DAMPING),
+                 "case_damping_ratios": [float(z) for z in cfg.mode_damping_ratios],
+                 "mode_frequencies_Hz": freqs, "healthy": {}, "cracked": {}}
+    _, ds_h, _ = records["healthy"]
+    shaft = cfg.tach_shaft[0]
+    omega = float(np.mean(ds_h[f"omega_{shaft}"].values))
+    out["mesh_period_s"] = 2.0 * math.pi / (omega * teeth)
+    out["decay_over_mesh_period"] = [1.0 / (zeta * 2.0 * math.pi * min(freqs))
+                                     / out["mesh_period_s"] for zeta in HOUSING_DAMPING]
+    for k in HOUSING_INDICATORS:
+        out["healthy"][k], out["cracked"][k] = [], []
+    for zeta in HOUSING_DAMPING:
+        tick(f"housing damping {100 * zeta:g}%")
+        chain = chain_from_config(cfg.model_copy(
+            update={"mode_damping_ratios": [zeta] * len(freqs)}))
+        avgs = {}
+        try:
+            for state, (_c, ds, _m) in records.items():
+                m = chain.measure(ds["time"].values, forces[state],
+                                  ds[f"theta_{shaft}"].values, ds[f"omega_{shaft}"].values)
+                tp = tach_pulse_times(m.tach, fs=m.fs) if np.ptp(m.tach) > 0 else np.empty(0)
+                avgs[state] = tsa(m.acc, tach_times=tp, fs=m.fs,
+                                  samples_per_rev=d.samples_per_rev, min_revolutions=2).average
+        except GeardynError as exc:  # a lightly damped path's memory outlasts a short record
+            out.setdefault("not_computed", {})[f"{zeta:g}"] = str(exc)
+            for state in ("healthy", "cracked"):
+                for k in HOUSING_INDICATORS:
+                    out[state][k].append(math.nan)
+            continue
+        v0 = central_moment(residual(avgs["healthy"], teeth=teeth, preset="zakrajsek"), 2)
+        for state, avg in avgs.items():
+            ind = measured_indicators(avg, teeth=teeth, harmonic=d.harmonic,
+                                      bandwidth=d.bandwidth, residual_preset=d.residual_preset,
+                                      na4_baseline_variance=v0)
+            for k in HOUSING_INDICATORS:
+                out[state][k].append(ind[k])
+    return out
 
 
 def _cache_key(case: Case, sim_case: Case, result: StudyResult, model: str) -> str:
@@ -291,7 +379,7 @@ def measurement_stage(case: Case, sim_case: Case, result: StudyResult, *,
     model = case.simulation.model
     cache = cache or default_cache()
     steps = {"n": 0}
-    total = 2 + 2 * len(VARIANTS)
+    total = 2 + 2 * len(VARIANTS) + len(HOUSING_DAMPING)
 
     def tick(item: str) -> None:
         result.emit(f"measurement: {item}", min(steps["n"], total), total)
@@ -428,6 +516,7 @@ def statements(data: dict) -> list[str]:
                    f"{_fmt(er_err_h)}, {cmp} than the cracked pair's without errors "
                    f"({_fmt(er_noise_c)}, noise only): the errors' difference signal is "
                    f"{cmp} than the crack's.")
+    out += housing_statements(data.get("housing_damping"))
     det = data["detections"]
     names = {"ideal": "the ideal record", "errors": "tooth errors only",
              "noise": "noise only", "errors+noise": "the realistic record (errors + noise)"}
@@ -445,3 +534,37 @@ def statements(data: dict) -> list[str]:
                        + (f" (largest cracked / healthy: {best[1]} x{best[0]:.3g})." if best
                           else "."))
     return out
+
+
+#: FM4 within this of 3 counts as "near 3" (a Gaussian difference signal) in the statements [-].
+GAUSSIAN_FM4_BAND = 0.5
+
+
+def housing_statements(hd: dict | None) -> list[str]:
+    """What :func:`housing_damping_sweep`'s numbers say, in words (computed, not written)."""
+    if not hd or "skipped" in hd:
+        return [] if not hd else [f"Housing damping not varied: {hd['skipped']}."]
+    z = hd["damping_ratios"]
+    fm = hd["healthy"]["FM4"]
+    ratio = hd["decay_over_mesh_period"]
+    near = [i for i, v in enumerate(fm) if math.isfinite(v) and abs(v - 3) <= GAUSSIAN_FM4_BAND]
+    own = ", ".join(f"{100 * v:g}%" for v in sorted(set(hd["case_damping_ratios"])))
+    text = ("Healthy FM4 of the realistic record with every housing mode's damping ratio set to "
+            + ", ".join(f"{100 * a:g}%: {_fmt(b)}" for a, b in zip(z, fm, strict=True))
+            + f" (this case's path: {own}; the lowest mode's decay time 1 / (zeta 2 pi f) is "
+            f"{ratio[-1]:.2g} to {ratio[0]:.2g} mesh periods over that range). ")
+    if hd.get("not_computed"):
+        text += ("Not computed at " + ", ".join(f"{100 * float(k):g}%" for k in
+                                                hd["not_computed"])
+                 + ": the record is too short for that path's memory (lengthen "
+                 "simulation.record_time). ")
+    if near:
+        text += ("FM4 is within " f"{GAUSSIAN_FM4_BAND:g} of 3, the value of a Gaussian "
+                 "difference signal, at " + ", ".join(f"{100 * z[i]:g}%" for i in near)
+                 + " (decay " + ", ".join(f"{ratio[i]:.2g}" for i in near)
+                 + " mesh periods); the tooth errors' transients of successive meshes overlap "
+                 "there, while a more damped path leaves them isolated and impulsive.")
+    else:
+        text += (f"FM4 is not within {GAUSSIAN_FM4_BAND:g} of 3 at any of these damping "
+                 "ratios.")
+    return [text]

@@ -849,6 +849,25 @@ def _measurement_section(rep: Report, m: dict, result: StudyResult, fig) -> None
               left_columns=1, classes=dcls,
               caption="Cracked / healthy of each indicator on the housing acceleration "
                       "(highlighted: above 1.5, the crack is seen)")
+    hd = m.get("housing_damping")
+    if hd and "skipped" not in hd:
+        hrows = []
+        for i, zeta in enumerate(hd["damping_ratios"]):
+            fh, fc = hd["healthy"]["FM4"][i], hd["cracked"]["FM4"][i]
+            hrows.append([100 * zeta, hd["decay_over_mesh_period"][i], fh, fc,
+                          fc / fh if fh else float("nan"), hd["cracked"]["NA4star"][i],
+                          hd["cracked"]["EnergyRatio"][i] / hd["healthy"]["EnergyRatio"][i]
+                          if hd["healthy"]["EnergyRatio"][i] else float("nan")])
+        rep.table(["damping ratio of every housing mode [%]",
+                   "decay time of the lowest mode / mesh period", "FM4 healthy", "FM4 cracked",
+                   "FM4 cracked / healthy", "NA4* cracked", "energy ratio cracked / healthy"],
+                  hrows, left_columns=0,
+                  caption="The realistic record (errors + noise) through the same transfer path "
+                          "with every mode's damping ratio set to each value: how much of the "
+                          "healthy FM4 the housing path makes (modes "
+                          + ", ".join(f"{f:g} Hz" for f in hd["mode_frequencies_Hz"])
+                          + "; this case's damping ratios: "
+                          + ", ".join(f"{100 * z:g}%" for z in hd["case_damping_ratios"]) + ")")
     rep.paragraph("What the numbers say (computed from the tables, not written by hand):")
     rep.bullets(statements(m))
     fig("fig24_measured_tsa", "TSA of the housing acceleration over one revolution from the "
