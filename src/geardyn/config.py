@@ -288,7 +288,7 @@ class FaultConfig(_Model):
     """One tooth fault of the ``faults`` list (geardyn.faults); which keys a type takes:
     root_crack (depth, angle, limit_line, width, front, slices), spall (start and length, or
     roll_start and roll_length, width, depth), breakage (height, width), wear (depth, start and
-    length or roll_start and roll_length, stiffness)."""
+    length or roll_start and roll_length, stiffness, law)."""
 
     type: Literal["root_crack", "spall", "breakage", "wear"] = Field(
         description="Fault type.")
@@ -316,6 +316,10 @@ class FaultConfig(_Model):
     height: Length | None = Field(None, description="breakage: height lost from the tip [m].")
     stiffness: bool | None = Field(None, description="wear: also thin the tooth in the PEM "
                                                      "stiffness (default false).")
+    law: Literal["uniform", "archard"] | None = Field(
+        None, description="wear: depth along the profile, 'uniform' (default) or 'archard' "
+                          "(Archard's law over one mesh: load share times sliding, zero at "
+                          "the pitch point; depth is then the largest depth).")
 
 
 class FEConfig(_Model):

@@ -213,8 +213,8 @@ class GearDeviations:
     source: str = "none"
     tolerances: dict = field(default_factory=dict)
     #: Wear faults of the ``faults`` list (:class:`geardyn.faults.Wear`) on this gear's teeth, as
-    #: ``(tooth, depth [m], u_a [m], u_b [m])``: a deviation ``depth`` over roll lengths
-    #: ``[u_a, u_b]`` of that tooth, added to its table.
+    #: ``(tooth, Wear, r_b [m])``: the deviation ``Wear.deviation(u / r_b)`` at roll length
+    #: ``u`` of that tooth, added to its table.
     wear: tuple = ()
 
     # ------------------------------------------------------------------ tables
@@ -232,7 +232,7 @@ class GearDeviations:
     def has_table(self) -> bool:
         """Whether any per-tooth deviation is non-zero."""
         return bool(np.any(self.pitch) or np.any(self.slope) or np.any(self.form)
-                    or any(w[1] > 0 for w in self.wear))
+                    or any(not w[1].is_null() for w in self.wear))
 
     @property
     def has_relief(self) -> bool:
@@ -251,8 +251,8 @@ class GearDeviations:
         shape ``(teeth, N_ROLL)`` [m]; constant beyond the ends when interpolated."""
         u = self.u_lo + self.du * np.arange(N_ROLL)
         tab = self.profile_exact(np.arange(self.teeth)[:, None], u[None, :])
-        for tooth, depth, ua, ub in self.wear:  # sampled at the nodes: edges ramp over du
-            tab[int(tooth) % self.teeth] += np.where((u >= ua) & (u <= ub), depth, 0.0)
+        for tooth, fault, rb in self.wear:  # sampled at the nodes: edges ramp over du
+            tab[int(tooth) % self.teeth] += fault.deviation(u / rb)
         return tab
 
     def profile_exact(self, tooth, u) -> np.ndarray:
@@ -391,9 +391,10 @@ class ToothModifications:
         return out._with_wear(case)
 
     def _with_wear(self, case) -> ToothModifications:
-        """Add the ``faults`` list's wear (:class:`geardyn.faults.Wear`, a uniform depth over a
-        roll window of one tooth: a profile deviation, :mod:`geardyn.faults.wear`) to the
-        deviation tables, so the dynamics and the static TE see the worn tooth's gap."""
+        """Add the ``faults`` list's wear (:class:`geardyn.faults.Wear`, a depth over a roll
+        window of one tooth, uniform or by Archard's law: a profile deviation,
+        :mod:`geardyn.faults.wear`) to the deviation tables, so the dynamics and the static TE see
+        the worn tooth's gap."""
         if not getattr(case, "faults", None):
             return self
         from .faults import Wear, faults_from_case
@@ -405,9 +406,9 @@ class ToothModifications:
         gears = {"pinion": self.pinion, "gear": self.gear}
         for f in wear:
             g = gears[f.gear]
-            a, b = f.window  # roll angles [rad]
-            entry = (int(f.tooth), float(f.depth), a * g.base_radius, b * g.base_radius)
-            src = f"wear of tooth {f.tooth} ({f.depth * 1e6:.4g} um)"
+            entry = (int(f.tooth), f, float(g.base_radius))  # roll length u = r_b * roll
+            law = "" if f.law == "uniform" else f", {f.law} profile, largest"
+            src = f"wear of tooth {f.tooth} ({f.depth * 1e6:.4g} um{law})"
             gears[f.gear] = replace(g, wear=(*g.wear, entry),
                                     source=src if g.source == "none" else f"{g.source}; {src}")
         return ToothModifications(self.pair, gears["pinion"], gears["gear"])

@@ -21,8 +21,8 @@ breakage      height, width                   pair stiffness times              
 spall         start+length or roll_start+     pair stiffness times              contact removed in a band of
               roll_length, width, depth       (L - b_s) / L on the window       width b_s while the contact
                                               (effective width)                 point is on the window
-wear          depth, window, stiffness        gap ``fault_gap``; with           the same ``fault_gap``;
-                                              ``stiffness`` the thinner         ``stiffness = true`` refused
+wear          depth, window, stiffness,       gap ``fault_gap``; with           the same ``fault_gap``;
+              law (uniform or Archard)        ``stiffness`` the thinner         ``stiffness = true`` refused
                                               section
 ============  ==============================  ================================  ==============================
 
@@ -59,11 +59,11 @@ from .base import FaultBase, active_roll_range, gear_of
 from .breakage import Breakage
 from .crack import FRONTS, N_SLICES, RootCrack
 from .spall import Spall
-from .wear import Wear
+from .wear import Wear, archard_scale, archard_shape
 
 __all__ = ["FaultBase", "RootCrack", "Spall", "Breakage", "Wear", "faults_from_case",
            "check_faults", "check_method", "fault_types", "FE_SUPPORTED", "KEYS",
-           "active_roll_range", "FRONTS", "N_SLICES"]
+           "active_roll_range", "FRONTS", "N_SLICES", "archard_scale", "archard_shape"]
 
 Fault = RootCrack | Spall | Breakage | Wear
 
@@ -72,7 +72,7 @@ KEYS = {
     "root_crack": ("depth", "angle", "limit_line", "width", "front", "slices"),
     "spall": ("start", "length", "roll_start", "roll_length", "width", "depth"),
     "breakage": ("height", "width"),
-    "wear": ("depth", "start", "length", "roll_start", "roll_length", "stiffness"),
+    "wear": ("depth", "start", "length", "roll_start", "roll_length", "stiffness", "law"),
 }
 #: Fault types the FE method models (:mod:`geardyn.stiffness.fe.faults`; with the limits that
 #: :func:`check_method` enforces).
@@ -151,8 +151,10 @@ def _from_config(cfg, i: int, pair, face_width: float) -> Fault:
         raise InputError(f"{label}.depth", None, "the depth worn off the flank (e.g. '10 um')")
     lo, hi = active_roll_range(pair, cfg.gear)
     a, du = _window(cfg, g, label, False, (lo, hi - lo))
+    law = cfg.law or "uniform"
+    shape = archard_shape(pair, cfg.gear, (a, a + du)) if law == "archard" and du > 0 else ()
     return Wear(**place, depth=cfg.depth, roll_start=a, roll_length=du,
-                stiffness=bool(cfg.stiffness))
+                stiffness=bool(cfg.stiffness), law=law, shape=shape)
 
 
 def _overlap(a: tuple[float, float], b: tuple[float, float]) -> bool:

@@ -24,6 +24,8 @@ def fault_labels(faulty) -> list[str]:
         text = f"{f.get('label')}: {f.get('type')} on {f.get('gear')} tooth {f.get('tooth')}"
         if isinstance(v, int | float):
             text += f", {word} {v * 1e3:g} mm"
+            if f.get("type") == "wear" and f.get("law") == "archard":
+                text += " at the deepest point (Archard profile)"
         out.append(text)
     return out
 
@@ -68,4 +70,11 @@ def fig_faults(healthy, faulty, centre_distance_change: float = 0.0, n: int = 40
     ax2.set_xlabel(r"pinion rolling angle $\theta$ [deg]")
     ax2.set_ylabel("change [%]")
     ax2.grid(True, alpha=0.3)
+    if "fault_gap" in getattr(faulty, "extra", {}):
+        # wear: the gap the worn pair closes before it carries load, largest over the slots
+        gap = np.max([np.asarray(faulty(th, centre_distance_change, "fault_gap", slot=k))
+                      for k in range(3)], axis=0)
+        ax3 = ax2.twinx()
+        ax3.plot(np.degrees(th), gap * 1e6, color="C0", lw=1.0)
+        ax3.set_ylabel("wear gap [um]", color="C0")
     return fig

@@ -173,7 +173,7 @@ def fault_record(f) -> dict:
 
     rec = {"type": f.kind, "label": f.label, "active": not f.is_null()}
     for fl in fields(f):
-        if fl.name in ("label",):
+        if fl.name in ("label", "shape"):  # an Archard shape is recomputed from the law
             continue
         v = getattr(f, fl.name)
         unit = {"depth": "_m", "width": "_m", "height": "_m", "face_width": "_m",
