@@ -61,7 +61,9 @@ def test_evaluate_run_end_to_end():
     from geardyn.dynamics import simulate, summary
     from geardyn.stiffness import build_map
 
-    case = paper_case(SHORT)
+    # the PEM map: what is tested is evaluate_run against diagnose on the same record; the FE
+    # map through a sweep is run by tests/faults/test_examples.py (crack-depth sweep)
+    case = paper_case({**SHORT, "stiffness.method": "pem"})
     feats = evaluate_run(case)
     ds = simulate(case, build_map(case, cracked=True))
     sig = {s: ds[s].values for s in ("v_yg", "omega_p", "transmission_error")}
