@@ -80,3 +80,37 @@ def test_zero_depth_is_no_wear_and_the_dynamics_see_the_gap(healthy_map):
     assert np.nanmax(e) == pytest.approx(DELTA, rel=1e-9)   # the worn pair alone in contact
     assert np.nanmin(e) >= 0.0 and np.mean(e == 0.0) > 0.5   # out of mesh most of the time
     assert np.std(w.transmission_error.values) != np.std(a.transmission_error.values)
+
+
+def test_the_healthy_runs_of_a_study_carry_no_wear(healthy_map, tmp_path):
+    """A study's healthy pair has no faults: ``without_faults`` removes the wear gap from the
+    tooth deviations (the maps leave faults out with ``cracked=False``); the faulty runs keep
+    it. Checked on ``geardyn simulate --no-crack`` and the ``geardyn run`` pipeline's cases."""
+    import subprocess
+    import sys
+
+    import xarray as xr
+
+    from geardyn.faults import without_faults
+
+    worn = _case()
+    assert ToothModifications.from_case(worn).active
+    healthy = without_faults(worn)
+    assert not ToothModifications.from_case(healthy).active and healthy.faults == []
+    plain = load_case(WEAR.parent.parent.parent / "src" / "geardyn" / "cases" / "xue_howard.toml")
+    assert without_faults(plain) is plain  # no faults: the same case, the same cache keys
+    args = [sys.executable, "-m", "geardyn", "simulate", "--config", str(WEAR), "--set",
+            "faults.0.stiffness=false", "--set", f"faults.0.depth={DELTA}", "--set",
+            "stiffness.centre_distances=3", "--set", "simulation.settle_time=0.02", "--set",
+            "simulation.record_time=0.06"]
+    for flag in ("--no-crack", "--crack"):
+        out = tmp_path / f"{flag}.nc"
+        r = subprocess.run([*args, flag, "--out", str(out)], capture_output=True, text=True,
+                           timeout=600)
+        assert r.returncode == 0, r.stderr
+        with xr.open_dataset(out) as ds:
+            if flag == "--no-crack":  # perfect teeth: no deviation recorded at all
+                assert "mesh_error" not in ds
+            else:
+                assert float(np.nanmax(ds["mesh_error"].values)) == pytest.approx(DELTA,
+                                                                                   rel=1e-9)

@@ -216,6 +216,11 @@ def test_housing_statements_follow_the_numbers():
     assert "1%: 3.2" in text and "5%: 6.6" in text and "at 1% (decay 2.2 mesh periods)" in text
     hd["healthy"]["FM4"] = [4.0, 6.6]
     assert "not within 0.5 of 3" in housing_statements(hd)[0]
+    # a damping not computed (record too short) is NaN, stored in the cached JSON as null
+    hd["healthy"]["FM4"] = [None, 3.2]
+    hd["not_computed"] = {"0.01": "too short"}
+    (text,) = housing_statements(hd)
+    assert "1%: undefined" in text and "Not computed at 1%" in text and "at 5%" in text
     assert housing_statements({"skipped": "an FRF table"}) == [
         "Housing damping not varied: an FRF table."]
     assert housing_statements(None) == []

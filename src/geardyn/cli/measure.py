@@ -33,7 +33,8 @@ def measure(
                               "simulation.model).",
         show_default=False)] = None,
     crack: Annotated[bool, typer.Option("--crack/--no-crack",
-                                        help="Include the case's tooth crack in the stiffness.")
+                                        help="Include the case's crack and faults (--no-crack: "
+                                             "the healthy pair, also without wear's gap).")
                      ] = True,
     out: Annotated[Path, typer.Option("--out", "-o", help="Output NetCDF file.")
                    ] = Path("measurement.nc"),
@@ -60,6 +61,10 @@ def measure(
     models = get_args(SimulationConfig.model_fields["model"].annotation)  # "I", "I-static", "II"
     model = choice("--model", model, models)  # before the case: a bad name fails at once
     case = load_case_from_cli(config, set_)
+    if not crack:  # the healthy pair: no faults at all (no wear gap either)
+        from ..faults import without_faults
+
+        case = without_faults(case)
     which = case.simulation.model if model is None else model
     if stiffness is not None and stiffness not in ("pem", "fe"):
         raise InputError("--stiffness", stiffness, "'pem' or 'fe'")

@@ -56,7 +56,8 @@ def simulate(
                               "iterated with the operating centre distance; any case (default: "
                               "the case's simulation.model).", show_default=False)] = None,
     crack: Annotated[bool, typer.Option("--crack/--no-crack",
-                                        help="Include the case's tooth crack in the stiffness.")
+                                        help="Include the case's crack and faults (--no-crack: the "
+                                             "healthy pair, also without wear's gap).")
                      ] = True,
     out: Annotated[Path | None, typer.Option(
         "--out", "-o", help=f"Output NetCDF file (default: {DEFAULT_OUT}). Re-running the same "
@@ -107,6 +108,10 @@ def simulate(
     from ..stiffness import build_map
 
     check_bounded_work(case)
+    if not crack:  # the healthy pair: no faults at all (no wear gap either)
+        from ..faults import without_faults
+
+        case = without_faults(case)
     ident = identity("simulate", case, {"model": which, "crack": crack, "stiffness": method})
     mat_path = out.with_suffix(".mat")
     up_to_date = False

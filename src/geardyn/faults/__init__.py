@@ -63,7 +63,8 @@ from .wear import Wear, archard_scale, archard_shape
 
 __all__ = ["FaultBase", "RootCrack", "Spall", "Breakage", "Wear", "faults_from_case",
            "check_faults", "check_method", "fault_types", "FE_SUPPORTED", "KEYS",
-           "active_roll_range", "FRONTS", "N_SLICES", "archard_scale", "archard_shape"]
+           "active_roll_range", "FRONTS", "N_SLICES", "archard_scale", "archard_shape",
+           "without_faults"]
 
 Fault = RootCrack | Spall | Breakage | Wear
 
@@ -220,6 +221,17 @@ def check_faults(case) -> None:
     """Validate the case's ``faults`` list (see :func:`faults_from_case`)."""
     if getattr(case, "faults", None):
         faults_from_case(case)
+
+
+def without_faults(case):
+    """The healthy gear pair of ``case``: the case without its ``faults`` list (the case itself
+    when it has none, so its cache keys stay). The stiffness maps leave the faults out with
+    ``cracked=False``; this also removes what the faults put into the tooth deviations (wear's
+    gap, :meth:`geardyn.modifications.ToothModifications.from_case`), for the healthy runs of a
+    study (``geardyn run``, ``simulate --no-crack``, ``measure --no-crack``)."""
+    if not getattr(case, "faults", None):
+        return case
+    return case.with_overrides({"faults": []})
 
 
 def check_method(case, method: str) -> None:

@@ -354,6 +354,7 @@ def simulation_stage(case: Case, out: Path, result: StudyResult) -> None:
     Each record is also written to ``runs/model_<M>_<state>.nc`` (compressed, one file per run).
     """
     from ..dynamics import summary as sim_summary
+    from ..faults import without_faults
     from . import paper_figures as pf
 
     sim_case = _simulation_case(case, result.quick)
@@ -365,6 +366,7 @@ def simulation_stage(case: Case, out: Path, result: StudyResult) -> None:
         "simulation.stiffness_evaluation": "start",
         "simulation.record_time": min(sim_case.simulation.record_time, 2.2 * rev)})
     total = len(jobs)
+    healthy_case = without_faults(sim_case)  # no wear gap on the healthy pair
     for i, (model, state) in enumerate(jobs):
         label = (f"model {model}, {state}" if model != "II-start"
                  else "model II, paper's start-of-step scheme")
@@ -372,7 +374,8 @@ def simulation_stage(case: Case, out: Path, result: StudyResult) -> None:
         if model == "II-start":
             ds = cached_simulation(scheme_case, result.maps[state], "II")
         else:
-            ds = cached_simulation(sim_case, result.maps[state], model)
+            ds = cached_simulation(sim_case if state == "cracked" else healthy_case,
+                                   result.maps[state], model)
         runs[(model, state)] = ds
         path = out / "runs" / run_file_name(model, state)
         _write_run_file(ds, path)

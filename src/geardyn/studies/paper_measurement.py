@@ -76,7 +76,7 @@ INDICATORS = (
 )
 
 #: Bump when the stage's results change meaning, so cached results are recomputed.
-MEASUREMENT_CACHE_VERSION = "3"
+MEASUREMENT_CACHE_VERSION = "4"
 
 #: Damping ratios of the housing modes [-] over which the realistic record's indicators are
 #: recomputed (every mode of the case's modal path set to each): how much of a healthy
@@ -94,16 +94,18 @@ DETECTION_RATIO = 1.5
 
 def _variant_cases(case: Case, sim_case: Case) -> tuple[Case, Case, str]:
     """``(case without errors, case with errors, description of the errors)``."""
+    from ..faults import without_faults
     from ..modifications import ToothModifications
 
-    if ToothModifications.from_case(sim_case).active:
+    if ToothModifications.from_case(without_faults(sim_case)).active:  # errors, not wear
         plain = sim_case.model_copy(update={"modifications": None})
         return plain, sim_case, ("the case's own [modifications]: "
-                                 + ToothModifications.from_case(sim_case).describe())
+                                 + ToothModifications.from_case(
+                                     without_faults(sim_case)).describe())
     err = sim_case.with_overrides(DEFAULT_ERRORS, source=DEFAULT_ERRORS_SOURCE)
     return sim_case, err, ("issue 14 default, drawn deviations spanning the whole tolerance "
                            "(cumulative pitch deviation = F_pT): "
-                           + ToothModifications.from_case(err).describe())
+                           + ToothModifications.from_case(without_faults(err)).describe())
 
 
 def _chains(case: Case):
@@ -192,16 +194,20 @@ def _compute(case: Case, sim_case: Case, result: StudyResult, model: str,
     from ..diagnostics import tach_pulse_times, tsa
     from ..diagnostics.metrics import central_moment
     from ..diagnostics.spectra import residual
+    from ..faults import without_faults
     from .measure import housing_forces
 
     plain, err, err_text = _variant_cases(case, sim_case)
     chains = _chains(case)
-    sim_toml = case_to_toml(sim_case)
+    # the healthy pair has no faults (no wear gap), as in the simulation stage
+    sim_toml = {"cracked": case_to_toml(sim_case),
+                "healthy": case_to_toml(without_faults(sim_case))}
     records = {}
-    for has_err, c in ((False, plain), (True, err)):
+    for has_err, c_faulty in ((False, plain), (True, err)):
         for state in ("healthy", "cracked"):
             key = (model, state)
-            if case_to_toml(c) == sim_toml and key in result.sims:
+            c = c_faulty if state == "cracked" else without_faults(c_faulty)
+            if case_to_toml(c) == sim_toml[state] and key in result.sims:
                 ds = result.sims[key]
             else:
                 tick(f"simulation with{'' if has_err else 'out'} tooth errors, {state}")
@@ -393,6 +399,11 @@ def measurement_stage(case: Case, sim_case: Case, result: StudyResult, *,
         load=lambda path: json.loads(path.read_text()))
     result.emit("measurement: indicators", total, total)
     data = dict(data)
+    hd = data.get("housing_damping")
+    if hd and "skipped" not in hd:  # the cached JSON holds NaN (not computed) as null
+        for state in ("healthy", "cracked"):
+            hd[state] = {k: [math.nan if x is None else x for x in v]
+                         for k, v in hd[state].items()}
     data["reference"] = _state_reference(result, model)
     if "skipped" not in data:
         # the diagnostics stage found the healthy map periodic (no errors): the ideal healthy
@@ -545,7 +556,7 @@ def housing_statements(hd: dict | None) -> list[str]:
     if not hd or "skipped" in hd:
         return [] if not hd else [f"Housing damping not varied: {hd['skipped']}."]
     z = hd["damping_ratios"]
-    fm = hd["healthy"]["FM4"]
+    fm = [math.nan if v is None else float(v) for v in hd["healthy"]["FM4"]]  # NaN: JSON null
     ratio = hd["decay_over_mesh_period"]
     near = [i for i, v in enumerate(fm) if math.isfinite(v) and abs(v - 3) <= GAUSSIAN_FM4_BAND]
     own = ", ".join(f"{100 * v:g}%" for v in sorted(set(hd["case_damping_ratios"])))
