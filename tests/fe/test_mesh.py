@@ -187,3 +187,20 @@ def test_bad_settings():
         MeshSettings(flank_size=-1.0, tooth_size=0.5e-3, body_size=2e-3)
     with pytest.raises(InputError):
         CrackGeometry(depth=1e-3, angle=2.0)
+
+
+def test_the_last_body_meshes_are_kept_for_the_figure():
+    """``build_body_mesh`` returns the mesh it just built for the same arguments (the figure of
+    the mesh reuses its body's mesh), read-only; other arguments mesh again."""
+    import geardyn
+    from geardyn.stiffness.fe.mesh import MeshSettings, build_body_mesh
+
+    g = geardyn.paper_case().gear_pair().pinion
+    ms = MeshSettings(flank_size=0.2e-3, tooth_size=1.6e-3, body_size=4.8e-3, refined_teeth=3)
+    a = build_body_mesh(g, ms)
+    assert build_body_mesh(g, ms) is a
+    assert not a.p.flags.writeable and not a.t.flags.writeable
+    coarser = MeshSettings(flank_size=0.25e-3, tooth_size=2.0e-3, body_size=6e-3,
+                           refined_teeth=3)
+    b = build_body_mesh(g, coarser)
+    assert b is not a and b.n_nodes < a.n_nodes
