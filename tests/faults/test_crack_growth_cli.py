@@ -104,6 +104,7 @@ def test_case_crack_refusals():
     (["--paris-c", "1e-11", "--paris-m", "3"], "--paris-c"),
     ([*PARIS, "--set", "faults.0.depth=20mm"], "faults[0].depth"),
     ([*PARIS, "--step-size", "5 mm"], "--step-size"),
+    ([*PARIS, "--stiffness", "iso"], "--stiffness"),
 ])
 def test_bad_input_is_one_line_exit_2(tmp_path, args, field):
     """In-process (typer's CliRunner): exit 2, one line naming the field, nothing written."""
@@ -185,3 +186,27 @@ def test_example_quick_through_the_cli(tmp_path):
     lines = (out / "crack_growth.csv").read_text().strip().splitlines()
     assert lines[0].startswith("crack_length [m],") and "K_I [Pa m^0.5]" in lines[0]
     assert len(lines) == a.size + 1
+
+
+@pytest.mark.slow
+def test_fe_map_of_the_grown_path_through_the_cli(tmp_path):
+    """``--stiffness fe``: each simulated length uses the FE map of the grown path itself (the
+    crack meshed along its polyline). The mesh stiffness falls with the crack length at the
+    cracked tooth's worst position and the indicators are finite; the first sample (the
+    initial straight crack) has the straight crack's FE stiffness (one-point path, checked to
+    round-off in tests/fe/test_crack_path_map.py)."""
+    import xarray as xr
+
+    out = tmp_path / "out"
+    r = _run(["--config", str(EXAMPLE), "--out", str(out), *PARIS, "--quick", "--points", "2",
+              "--stiffness", "fe"], tmp_path)
+    assert r.returncode == 0, r.stderr
+    with xr.open_dataset(out / "crack_growth.nc", engine="h5netcdf") as ds:
+        ds = ds.load()
+    assert ds.attrs["indicator_stiffness"] == "fe"
+    assert "grown crack path" in ds["mesh_stiffness"].attrs["long_name"]
+    assert list(ds["simulation_status"].values) == ["ok"] * 2
+    k, kh = ds["mesh_stiffness"].values, ds["healthy_mesh_stiffness"].values
+    loss = ((kh[None, :] - k) / kh[None, :]).max(axis=1)
+    assert 0 < loss[0] < loss[1], loss
+    assert np.all(np.isfinite(ds["v_yg__FM4"].values))

@@ -17,6 +17,7 @@ from ._common import (
     ForceOption,
     SetOption,
     StageProgress,
+    choice,
     console,
     handle_errors,
     load_case_from_cli,
@@ -157,6 +158,10 @@ def crack_growth(
     quick: Annotated[bool, typer.Option(
         "--quick", help="A coarse, fast run: module/4 steps, at most 20, 3 simulated lengths, "
                         "0.2 s settle and 0.3 s record.")] = False,
+    stiffness: Annotated[str, typer.Option(
+        "--stiffness", help="Mesh stiffness of the simulated lengths: 'pem' (the equivalent "
+                            "straight crack, fast) or 'fe' (the grown path itself meshed, one FE "
+                            "body per length, about 7 s each).")] = "pem",
     out: Annotated[Path | None, typer.Option(
         "--out", "-o", help=f"Output folder (default: {DEFAULT_OUT}).", show_default=False)
                    ] = None,
@@ -164,7 +169,8 @@ def crack_growth(
 ) -> None:
     """Grow the case's root crack (its crack section or a faults root_crack entry) under the
     mesh force of motor.torque at the highest point of single tooth contact, then simulate a few
-    crack lengths (PEM map of the equivalent straight crack): the path, K_I, K_II, Paris cycles,
+    crack lengths (PEM map of the equivalent straight crack, or with --stiffness fe the FE map
+    of the grown path): the path, K_I, K_II, Paris cycles,
     the FE compliance and the indicators against cycles go to OUT as crack_growth.nc,
     crack_growth.csv and figures."""
     import warnings
@@ -197,6 +203,7 @@ def crack_growth(
     if snr is not None and (no_noise or not math.isfinite(snr)):
         raise InputError("--snr", snr, "a finite signal-to-noise ratio in dB, without --no-noise")
     noise_snr_db = None if no_noise else (20.0 if snr is None else float(snr))
+    stiffness = choice("--stiffness", stiffness, ("pem", "fe"))
     case = load_case_from_cli(config, set_)
 
     from ..faults.tooth_growth import check_step, initial_geometry
@@ -214,7 +221,8 @@ def crack_growth(
     record = QUICK["record_time"] if quick else None
     options = {"paris_c_si": c_si, "paris_m": paris_m, "paris_threshold_si": dk_th,
                "steps": n_steps, "step_m": step, "points": n_points, "quick": quick,
-               "noise_snr_db": noise_snr_db}
+               "noise_snr_db": noise_snr_db,
+               **({"stiffness": "fe"} if stiffness == "fe" else {})}
     ident = identity("crack-growth", case, options)
     state = claim_folder(target, ident, force=force, results=RESULTS, record=False)
 
@@ -229,7 +237,7 @@ def crack_growth(
         ds = crack_growth_study(case, paris_c=c_si, paris_m=paris_m, paris_threshold=dk_th,
                                 step=step, n_steps=n_steps, points=n_points,
                                 settle_time=settle, record_time=record,
-                                noise_snr_db=noise_snr_db,
+                                noise_snr_db=noise_snr_db, stiffness=stiffness,
                                 progress=progress)
         progress.close()
     say_state(state, target)

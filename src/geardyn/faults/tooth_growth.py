@@ -60,7 +60,7 @@ from .growth import equivalent_k, mts_angle, paris_cycles
 
 __all__ = ["ToothCrackPath", "grow_tooth_crack", "tooth_sector_outline", "hpstc_roll",
            "CaseCrack", "case_crack", "tooth_load", "equivalent_crack", "grow_case_crack",
-           "growth_dataset"]
+           "growth_dataset", "crack_at"]
 
 
 @dataclass(frozen=True)
@@ -464,6 +464,20 @@ def initial_geometry(case):
         key = str(exc.field).rsplit(".", 1)[-1]
         raise InputError(f"{c.field}.{key}", exc.value, exc.allowed) from None
     return c, gear, geom, mouth, tip
+
+
+def crack_at(growth, k: int, depth: float, angle: float) -> CrackGeometry:
+    """The grown crack at crack length index ``k`` of ``growth`` (:func:`growth_dataset`) as a
+    polyline :class:`geardyn.stiffness.fe.mesh.CrackGeometry` for the FE mesh stiffness: the
+    path from the mouth through the tips of steps ``0..k``; ``depth`` [m] and ``angle`` [rad]
+    record the initial crack it grew from."""
+    n = growth.sizes["crack_length"]
+    if not 0 <= int(k) < n:
+        raise InputError("k", k, f"a crack length index in [0, {n - 1}]")
+    x, y = growth["path_x"].values, growth["path_y"].values
+    pts = tuple((float(a), float(b)) for a, b in zip(x[1:int(k) + 2], y[1:int(k) + 2],
+                                                      strict=True))
+    return CrackGeometry(depth=float(depth), angle=float(angle), path=pts)
 
 
 def equivalent_crack(mouth, tip) -> tuple[float, float]:

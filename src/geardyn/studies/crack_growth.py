@@ -8,9 +8,10 @@ What it composes (no physics of its own):
    Paris-law cycles and the FE load-point compliance per crack length.
 2. At ``points`` crack lengths along the path (evenly spread over its analysed tips, the initial
    crack and the last tip included), the PEM mesh stiffness map of the **equivalent straight
-   crack**, :func:`geardyn.dynamics.simulate` of the case's model on it, and the condition
-   metrics of :func:`geardyn.studies.sweep.evaluate.diagnostic_features` (TSA against the
-   cracked gear's exact angle, residual, demodulation, FM0/FM4/M6A/M8A/NA4/NB4/energy ratio)
+   crack** (or the FE map of the grown path, below), :func:`geardyn.dynamics.simulate` of
+   the case's model on it, and the condition metrics of
+   :func:`geardyn.studies.sweep.evaluate.diagnostic_features` (TSA against the cracked gear's
+   exact angle, residual, demodulation, FM0/FM4/M6A/M8A/NA4/NB4/energy ratio)
    for each signal; and the same for the healthy pair (no faults) as the baseline.
 
 The equivalent straight crack (an approximation, stated in the output)
@@ -26,6 +27,15 @@ length (``compliance``) is the consistent stiffness measure of the grown crack. 
 the PEM's domain (angle outside ``(0, pi/2)``, tip beyond the opposite fillet) or a simulation
 that fails (a nearly broken tooth can separate and run away) leaves that sample's indicators
 NaN with the reason in ``simulation_status``.
+
+The FE map of the grown path (``stiffness="fe"``, ``geardyn crack-growth --stiffness fe``)
+---------------------------------------------------------------------------------------
+Instead of the chord, the FE mesh stiffness of the path itself: the crack is meshed along its
+polyline from the mouth through every tip up to the sample
+(:class:`geardyn.stiffness.fe.mesh.CrackGeometry` with ``path``,
+:func:`geardyn.faults.tooth_growth.crack_at`), one whole FE body per sample (cached). The first
+sample, the initial straight crack, gives the straight crack's FE map to round-off
+(``tests/fe/test_crack_path_map.py``).
 
 The simulated records are short when the caller asks (``settle_time``, ``record_time``). White
 Gaussian noise at ``noise_snr_db`` (default 20 dB, as in the shipped sweep) is added to each
@@ -102,7 +112,8 @@ def _features(case, smap, signals, shaft: str, teeth: int, noise_snr_db: float |
 def add_indicators(case, growth, *, points: int = 5, settle_time: float | None = None,
                    record_time: float | None = None, signals: Sequence[str] = DEFAULT_SIGNALS,
                    n_angle: int = 4096, noise_snr_db: float | None = 20.0, seed: int = 0,
-                   progress: Callable[[int, int], None] | None = None):
+                   progress: Callable[[int, int], None] | None = None,
+                   stiffness: str = "pem"):
     """Indicators against cycles at ``points`` crack lengths of a grown path (module docstring).
 
     Parameters
@@ -126,6 +137,11 @@ def add_indicators(case, growth, *, points: int = 5, settle_time: float | None =
         Seed of the noise (sample ``i`` uses ``seed + i``).
     progress : callable, optional
         ``progress(done, total)`` per simulation (healthy first).
+    stiffness : {"pem", "fe"}
+        ``"pem"``: the PEM map of the equivalent straight crack (module docstring); ``"fe"``:
+        the FE map of the grown path itself (the crack meshed as the polyline from the mouth
+        through every tip up to the sample, :func:`geardyn.faults.tooth_growth.crack_at`; one
+        FE body per sample, cached).
 
     Returns
     -------
@@ -139,13 +155,15 @@ def add_indicators(case, growth, *, points: int = 5, settle_time: float | None =
     """
     import xarray as xr
 
-    from ..faults.tooth_growth import case_crack, equivalent_crack
+    from ..faults.tooth_growth import case_crack, crack_at, equivalent_crack
     from ..stiffness import build_map
 
     c = case_crack(case)
+    if stiffness not in ("pem", "fe"):
+        raise InputError("stiffness", stiffness, "'pem' or 'fe'")
     n = growth.sizes["crack_length"]
     idx = sample_indices(n, points)
-    over: dict[str, object] = {"stiffness.method": "pem"}
+    over: dict[str, object] = {"stiffness.method": stiffness}
     if settle_time is not None:
         over["simulation.settle_time"] = float(settle_time)
     if record_time is not None:
@@ -176,11 +194,15 @@ def add_indicators(case, growth, *, points: int = 5, settle_time: float | None =
         depth[j], angle[j] = q, v
         row = None
         try:
-            if not 0 < v < math.pi / 2:
-                raise InputError(f"{c.field}.angle", v, "an equivalent crack angle in (0, pi/2) "
-                                                        "rad (the chord leaves the PEM's domain)")
-            cs = base.with_overrides({f"{c.key}.depth": q, f"{c.key}.angle": v})
-            smap = build_map(cs, cracked=True)
+            if stiffness == "fe":  # the grown path itself, meshed
+                cs = base
+                smap = _fe_path_map(base, crack_at(growth, int(k), c.depth, c.angle))
+            else:
+                if not 0 < v < math.pi / 2:
+                    raise InputError(f"{c.field}.angle", v, "an equivalent crack angle in (0, "
+                                     "pi/2) rad (the chord leaves the PEM's domain)")
+                cs = base.with_overrides({f"{c.key}.depth": q, f"{c.key}.angle": v})
+                smap = build_map(cs, cracked=True)
             period = smap.period
             th = np.linspace(0.0, period, n_angle, endpoint=False)
             row = np.asarray(smap(th, 0.0), float)
@@ -210,11 +232,13 @@ def add_indicators(case, growth, *, points: int = 5, settle_time: float | None =
         "simulation_status": (S, np.array(status, dtype=object),
                               {"long_name": "'ok', or why the sample's indicators are NaN"}),
         "mesh_stiffness": ((S, "angle"), kmat,
-                           {"units": "N/m", "long_name": "PEM mesh stiffness of the equivalent "
-                                                         "crack at the design centre distance"}),
+                           {"units": "N/m", "long_name": (
+                               "PEM mesh stiffness of the equivalent crack" if stiffness == "pem"
+                               else "FE mesh stiffness of the grown crack path")
+                            + " at the design centre distance"}),
         "healthy_mesh_stiffness": ("angle", np.asarray(healthy_map(th, 0.0), float),
-                                   {"units": "N/m", "long_name": "PEM mesh stiffness of the "
-                                                                 "healthy pair (no faults)"}),
+                                   {"units": "N/m", "long_name": f"{stiffness.upper()} mesh "
+                                    "stiffness of the healthy pair (no faults)"}),
     }
     for s in signals:
         for m, long in METRICS.items():
@@ -231,8 +255,10 @@ def add_indicators(case, growth, *, points: int = 5, settle_time: float | None =
     out = xr.merge([growth, ind], combine_attrs="override")
     sim = base.simulation
     out.attrs.update({
-        "equivalent_crack": EQUIVALENT_CRACK_NOTE,
-        "indicator_stiffness": "pem",
+        "equivalent_crack": (EQUIVALENT_CRACK_NOTE if stiffness == "pem" else
+                             "not used: the indicators use the FE map of the grown path itself "
+                             "(equivalent_depth and equivalent_angle describe its chord only)"),
+        "indicator_stiffness": stiffness,
         "indicator_model": sim.model,
         "indicator_settle_time_s": float(sim.settle_time),
         "indicator_record_time_s": float(sim.record_time),
@@ -247,12 +273,21 @@ def add_indicators(case, growth, *, points: int = 5, settle_time: float | None =
     return out
 
 
+def _fe_path_map(case, crack):
+    """The FE mesh stiffness map of ``case`` with its root crack replaced by ``crack`` (a
+    grown path) on the case's centre-distance grid (bodies cached by their crack)."""
+    from ..stiffness import centre_distance_grid
+    from ..stiffness.fe import fe_map
+
+    return fe_map(case, centre_distance_grid(case), cracked=True, crack=crack)
+
+
 def crack_growth_study(case, *, paris_c: float, paris_m: float, paris_threshold: float = 0.0,
                        step: float | None = None, n_steps: int = 60, points: int = 5,
                        settle_time: float | None = None, record_time: float | None = None,
                        signals: Sequence[str] = DEFAULT_SIGNALS,
                        noise_snr_db: float | None = 20.0, seed: int = 0,
-                       progress: Callable[..., None] | None = None):
+                       progress: Callable[..., None] | None = None, stiffness: str = "pem"):
     """Grow the case's crack and compute the indicators against cycles (module docstring).
 
     Parameters
@@ -261,7 +296,7 @@ def crack_growth_study(case, *, paris_c: float, paris_m: float, paris_threshold:
     paris_c, paris_m, paris_threshold, step, n_steps
         As in :func:`geardyn.faults.tooth_growth.grow_case_crack` (``C`` in
         m/cycle/(Pa m^0.5)^m, ``Delta K_th`` in Pa m^0.5, ``step`` in m).
-    points, settle_time, record_time, signals, noise_snr_db, seed
+    points, settle_time, record_time, signals, noise_snr_db, seed, stiffness
         As in :func:`add_indicators`.
     progress : callable, optional
         ``progress(stage, done, total)`` with stages ``"crack growth"`` and ``"indicators"``.
@@ -287,4 +322,5 @@ def crack_growth_study(case, *, paris_c: float, paris_m: float, paris_threshold:
         progress("crack growth", n, n)
     return add_indicators(case, growth, points=points, settle_time=settle_time,
                           record_time=record_time, signals=signals,
-                          noise_snr_db=noise_snr_db, seed=seed, progress=stage("indicators"))
+                          noise_snr_db=noise_snr_db, seed=seed, progress=stage("indicators"),
+                          stiffness=stiffness)

@@ -30,7 +30,7 @@ def fig_crack_path(ds):
     px, py = ds["path_x"].values * 1e3, ds["path_y"].values * 1e3
     ax.plot(px, py, "-o", color="C3", ms=3, lw=1.4, label="grown crack path")
     ax.plot(px[:2], py[:2], "-", color="k", lw=2.0, label="initial crack")
-    if "equivalent_depth" in ds:
+    if "equivalent_depth" in ds and ds.attrs.get("indicator_stiffness", "pem") == "pem":
         for q, v in zip(ds["equivalent_depth"].values, ds["equivalent_angle"].values,
                         strict=True):
             if np.isfinite(q) and np.isfinite(v):
@@ -109,16 +109,24 @@ def fig_indicators(ds, metrics=("FM4", "NA4", "EnergyRatio"), signals=None):
             ax.axhline(float(ds[f"{key}_healthy"].values), color=f"C{i}", ls="--", lw=0.8)
         ax.set_ylabel(m)
         ax.grid(True, alpha=0.3)
-    axes[0].set_title("Indicators against load cycles (dashed: healthy pair; PEM of the "
-                      "equivalent straight crack)", fontsize="medium")
+    axes[0].set_title("Indicators against load cycles (dashed: healthy pair; "
+                      f"{_stiffness_label(ds)})", fontsize="medium")
     axes[0].legend(fontsize="small")
     axes[-1].set_xlabel("load cycles from the initial crack")
     return fig
 
 
+def _stiffness_label(ds) -> str:
+    """Which mesh stiffness the indicators used (``attrs["indicator_stiffness"]``)."""
+    if ds.attrs.get("indicator_stiffness", "pem") == "fe":
+        return "FE map of the grown path"
+    return "PEM of the equivalent straight crack"
+
+
 def fig_mesh_stiffness(ds):
-    """The PEM mesh stiffness of each sampled equivalent crack and of the healthy pair [N/m]
-    against pinion angle [deg], at the design centre distance."""
+    """The mesh stiffness of each sampled crack (PEM of the equivalent straight crack, or FE
+    of the grown path) and of the healthy pair [N/m] against pinion angle [deg], at the design
+    centre distance."""
     fig = _figure()
     ax = fig.subplots()
     th = np.degrees(ds["angle"].values)
@@ -128,7 +136,7 @@ def fig_mesh_stiffness(ds):
                 label=f"{a * 1e3:.3g} mm, N = {ds['sample_cycles'].values[j]:.3g}")
     ax.set_xlabel(r"pinion angle $\theta$ [deg]")
     ax.set_ylabel(r"$k_{mb}$ [N/m]")
-    ax.set_title("Mesh stiffness per crack length (equivalent straight crack)")
+    ax.set_title(f"Mesh stiffness per crack length ({_stiffness_label(ds)})")
     ax.legend(fontsize="x-small", loc="lower right")
     ax.grid(True, alpha=0.3)
     return fig

@@ -57,7 +57,8 @@ __all__ = ["fe_map", "plot_mesh", "FEStiffness", "FESettings", "body_influence"]
 
 
 def fe_map(case, dd: np.ndarray, *, cracked: bool,
-           progress: Callable[[int, int], None] | None = None, cache=None) -> StiffnessMap:
+           progress: Callable[[int, int], None] | None = None, cache=None,
+           crack=None) -> StiffnessMap:
     """FE stiffness map of a case over one pinion revolution.
 
     Parameters
@@ -75,6 +76,8 @@ def fe_map(case, dd: np.ndarray, *, cracked: bool,
         then each centre distance.
     cache : geardyn.cache.Cache, optional
         Where the bodies' influence coefficients are cached (default cache).
+    crack : CrackGeometry, optional
+        Replaces the case's root crack geometry (:class:`FEStiffness`), e.g. a grown path.
 
     Returns
     -------
@@ -94,7 +97,7 @@ def fe_map(case, dd: np.ndarray, *, cracked: bool,
         if progress is not None:
             progress(i, n + dd.size)
 
-    model = FEStiffness(case, cracked=cracked, cache=cache, progress=p_bodies)
+    model = FEStiffness(case, cracked=cracked, cache=cache, progress=p_bodies, crack=crack)
 
     def p_lines(i: int, _n: int) -> None:
         if progress is not None:

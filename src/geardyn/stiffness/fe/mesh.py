@@ -46,7 +46,8 @@ from ...errors import InputError, NumericalError
 from ...geometry import Gear
 
 __all__ = ["MeshSettings", "CrackGeometry", "BodyMesh", "build_body_mesh", "loaded_flank",
-           "critical_fillet_point", "crack_segment", "tooth_offsets", "cut_flank", "check_cut"]
+           "critical_fillet_point", "crack_segment", "crack_polyline", "tooth_offsets", "cut_flank",
+           "check_cut"]
 
 #: Serialises every use of gmsh in this process. gmsh keeps one global model and is not
 #: thread-safe: two threads meshing at once (a Dask worker with several threads, say) crash the
@@ -95,25 +96,34 @@ class MeshSettings:
 
 @dataclass(frozen=True)
 class CrackGeometry:
-    """A straight root crack on the loaded-side fillet of model tooth 0.
+    """A root crack on the loaded-side fillet of model tooth 0: straight, or a polyline.
 
     Attributes
     ----------
     depth : float
-        Crack length from the mouth on the fillet to the tip [m].
+        Crack length from the mouth on the fillet to the tip [m] (a straight crack).
     angle : float
         Angle between the crack and the tooth centreline [rad], in (0, pi/2); the crack runs
         towards the centreline and towards the gear centre.
+    path : tuple of (x, y)
+        Optional: the crack as a polyline from the mouth through these points, the last one the
+        tip, body frame [m] (a grown crack, :mod:`geardyn.faults.tooth_growth`); ``depth`` and
+        ``angle`` then describe the crack it grew from and are not meshed.
     """
 
     depth: float
     angle: float
+    path: tuple = ()
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.depth) and self.depth > 0):
             raise InputError("crack.depth", self.depth, "a crack length > 0 [m]")
         if not 0 < self.angle < math.pi / 2:
             raise InputError("crack.angle", self.angle, "an angle in (0, pi/2) rad")
+        pts = tuple((float(x), float(y)) for x, y in self.path)
+        if not all(math.isfinite(v) for q in pts for v in q):
+            raise InputError("crack.path", self.path, "finite points (x, y) [m]")
+        object.__setattr__(self, "path", pts)
 
 
 @dataclass(frozen=True)
@@ -231,9 +241,36 @@ def _inside(poly: np.ndarray, pts: np.ndarray) -> np.ndarray:
     return Path(poly).contains_points(pts)
 
 
+def crack_polyline(gear: Gear, crack: CrackGeometry) -> np.ndarray:
+    """The crack from the mouth to the tip, shape (k, 2), body frame [m] (checked)."""
+    mouth, tip = crack_segment(gear, crack)
+    if not crack.path:
+        return np.array([mouth, tip])
+    return np.vstack([mouth, np.asarray(crack.path, float)])
+
+
+def _check_path(gear: Gear, crack: CrackGeometry, mouth: np.ndarray) -> np.ndarray:
+    """Tip of a polyline crack after checking that it stays inside the body [m]."""
+    pts = np.vstack([mouth, np.asarray(crack.path, float)])
+    seg = np.diff(pts, axis=0)
+    if np.any(np.hypot(*seg.T) <= 1e-9):
+        raise InputError("crack.path", "repeated point", "distinct consecutive points")
+    poly = _closed_polygon(gear)
+    s = np.linspace(0.02, 1.0, 20)[:, None, None]
+    samples = (pts[:-1][None] + s * seg[None]).reshape(-1, 2)
+    tip = pts[-1]
+    if not np.all(_inside(poly, samples)) or np.hypot(*tip) < gear.bore_radius + gear.module:
+        raise InputError("crack.path", f"tip at ({tip[0]:.4g}, {tip[1]:.4g}) m",
+                         "a crack path that stays inside the tooth and the rim (it leaves the "
+                         "body or comes within one module of the bore)")
+    return tip
+
+
 def crack_segment(gear: Gear, crack: CrackGeometry) -> tuple[np.ndarray, np.ndarray]:
     """Mouth and tip of the crack on model tooth 0, body frame [m]; checks the tip is inside."""
     mouth = critical_fillet_point(gear)
+    if crack.path:
+        return mouth, _check_path(gear, crack, mouth)
     direction = np.array([math.sin(crack.angle), -math.cos(crack.angle)])  # to +x: centreline
     tip = mouth + crack.depth * direction
     if abs(tip[0]) >= abs(mouth[0]):
@@ -444,14 +481,17 @@ def _build_body_mesh(gear: Gear, settings: MeshSettings, crack: CrackGeometry | 
             named["bore"] = bore
             inner = geo.addCurveLoop(bore)
             surf = geo.addPlaneSurface([outer, inner])
-            crack_line = None
-            if crack is not None:
-                p_tip = geo.addPoint(float(tip[0]), float(tip[1]), 0.0, lc)
-                crack_line = geo.addLine(crack_mouth_tag, p_tip)
+            crack_lines = []
+            if crack is not None:  # mouth -> tip, or through the path's points
+                tags = [crack_mouth_tag] + [geo.addPoint(float(x), float(y), 0.0, lc)
+                                            for x, y in crack_polyline(gear, crack)[1:]]
+                p_tip = tags[-1]
+                crack_lines = [geo.addLine(a, b) for a, b in zip(tags[:-1], tags[1:],
+                                                                 strict=True)]
             geo.synchronize()
-            if crack_line is not None:
-                gmsh.model.mesh.embed(1, [crack_line], 2, surf)
-                named["crack"] = [crack_line]
+            if crack_lines:
+                gmsh.model.mesh.embed(1, crack_lines, 2, surf)
+                named["crack"] = crack_lines
 
             # ---- size fields
             fld = gmsh.model.mesh.field
@@ -484,7 +524,7 @@ def _build_body_mesh(gear: Gear, settings: MeshSettings, crack: CrackGeometry | 
             fld.setNumber(t2, "DistMin", gear.module)
             fld.setNumber(t2, "DistMax", gear.module + (hb - ht) / (g - 1))
             fields.append(t2)
-            if crack_line is not None:
+            if crack_lines:
                 f3 = fld.add("Distance")
                 fld.setNumbers(f3, "PointsList", [p_tip])
                 t3 = fld.add("Threshold")
@@ -494,7 +534,7 @@ def _build_body_mesh(gear: Gear, settings: MeshSettings, crack: CrackGeometry | 
                 fld.setNumber(t3, "DistMin", 2 * hf)
                 fld.setNumber(t3, "DistMax", 2 * hf + (hb - hf) / (g - 1))
                 f4 = fld.add("Distance")
-                fld.setNumbers(f4, "CurvesList", [crack_line])
+                fld.setNumbers(f4, "CurvesList", crack_lines)
                 fld.setNumber(f4, "Sampling", 200)
                 t4 = fld.add("Threshold")
                 fld.setNumber(t4, "InField", f4)
@@ -548,7 +588,19 @@ def _build_body_mesh(gear: Gear, settings: MeshSettings, crack: CrackGeometry | 
     for j in offsets:
         edges[f"flank{j}"] = _orient_by_radius(p, edges[f"flank{j}"])
     info = {"n_nodes_before_crack": int(p.shape[1])}
-    if crack is not None:
+    if crack is not None and crack.path:  # a polyline: the topological split
+        from .crack_mesh import split_crack
+
+        seg = edges.pop("crack")
+        nodes = np.unique(seg)
+        d_tip = np.hypot(*(p[:, nodes] - tip[:, None]))
+        if d_tip.min() > 1e-9:
+            raise NumericalError("crack tip node not found in the mesh")
+        p, tri, plus, minus = split_crack(p, tri, seg, [int(nodes[np.argmin(d_tip)])],
+                                          crack_polyline(gear, crack))
+        edges["crack+"] = plus
+        edges["crack-"] = minus
+    elif crack is not None:
         p, tri, plus, minus = _split_crack(p, tri, edges.pop("crack"), mouth, tip)
         edges["crack+"] = plus
         edges["crack-"] = minus

@@ -339,11 +339,15 @@ class FEStiffness:
         Load points per flank.
     settings : FESettings, optional
         Override the settings derived from the case (studies of the numerical parameters).
+    crack : CrackGeometry, optional
+        Replaces the geometry of the case's one root crack, e.g. by a grown crack path
+        (:func:`geardyn.faults.tooth_growth.crack_at`); the case must have exactly one root
+        crack, through the face, and ``cracked`` must be true.
     """
 
     def __init__(self, case, *, cracked: bool = True, cache=None,
                  progress: Callable[[int, int], None] | None = None, n_points: int = 48,
-                 settings: FESettings | None = None):
+                 settings: FESettings | None = None, crack: CrackGeometry | None = None):
         from ...faults import faults_from_case
         from .faults import body_faults, check_fe_faults, face_bands
 
@@ -365,6 +369,13 @@ class FEStiffness:
         #: geometry of the first root crack (the ``[crack]`` section's when enabled)
         self.crack = None if not cracks else CrackGeometry(depth=float(cracks[0].depth),
                                                            angle=float(cracks[0].angle))
+        if crack is not None:
+            bodies = {st.body for band in self.bands for _k, st in band.teeth
+                      if st.body is not None}
+            if len(cracks) != 1 or len(bodies) != 1:
+                raise InputError("crack", "a crack geometry", "a case with exactly one "
+                                 "through-face root crack (and no other faulty body) to replace")
+            self.crack = crack
         gears = {"pinion": self.pair.pinion, "gear": self.pair.gear}
         jobs = [("pinion", self.pair.pinion, None, None), ("gear", self.pair.gear, None, None)]
         names: dict[tuple, str] = {}
@@ -372,7 +383,7 @@ class FEStiffness:
             for i, bk in enumerate(sorted(keys, key=repr)):
                 name = f"{which}{tooth}" + (f"_{i}" if len(keys) > 1 else "")
                 names[(which, tooth, bk)] = name
-                jobs.append((name, gears[which], bk[0], bk[1]))
+                jobs.append((name, gears[which], bk[0] if crack is None else crack, bk[1]))
         self.influence: dict[str, BodyInfluence] = {}
         self.from_cache: dict[str, bool] = {}
         for k, (name, gear, cr, cut) in enumerate(jobs):

@@ -87,6 +87,9 @@ def build_part_mesh(gear: Gear, settings: MeshSettings, part: str, *,
 
     if part not in ("H", "R"):
         raise InputError("part", part, "'H' or 'R'")
+    if crack is not None and crack.path:
+        raise InputError("stiffness.fe.substructure", True,
+                         "false for a crack path (substructuring meshes straight cracks)")
     if part == "H" and (crack is not None or cut_radius is not None):
         raise InputError("part", part, "'R' for a crack or a cut (faults live in R)")
     z = gear.teeth
