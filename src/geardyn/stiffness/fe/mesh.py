@@ -483,11 +483,7 @@ def _build_body_mesh(gear: Gear, settings: MeshSettings, crack: CrackGeometry | 
             surf = geo.addPlaneSurface([outer, inner])
             crack_lines = []
             if crack is not None:  # mouth -> tip, or through the path's points
-                tags = [crack_mouth_tag] + [geo.addPoint(float(x), float(y), 0.0, lc)
-                                            for x, y in crack_polyline(gear, crack)[1:]]
-                p_tip = tags[-1]
-                crack_lines = [geo.addLine(a, b) for a, b in zip(tags[:-1], tags[1:],
-                                                                 strict=True)]
+                crack_lines, p_tip = embed_crack(geo, gear, crack, crack_mouth_tag, lc)
             geo.synchronize()
             if crack_lines:
                 gmsh.model.mesh.embed(1, crack_lines, 2, surf)
@@ -588,20 +584,8 @@ def _build_body_mesh(gear: Gear, settings: MeshSettings, crack: CrackGeometry | 
     for j in offsets:
         edges[f"flank{j}"] = _orient_by_radius(p, edges[f"flank{j}"])
     info = {"n_nodes_before_crack": int(p.shape[1])}
-    if crack is not None and crack.path:  # a polyline: the topological split
-        from .crack_mesh import split_crack
-
-        seg = edges.pop("crack")
-        nodes = np.unique(seg)
-        d_tip = np.hypot(*(p[:, nodes] - tip[:, None]))
-        if d_tip.min() > 1e-9:
-            raise NumericalError("crack tip node not found in the mesh")
-        p, tri, plus, minus = split_crack(p, tri, seg, [int(nodes[np.argmin(d_tip)])],
-                                          crack_polyline(gear, crack))
-        edges["crack+"] = plus
-        edges["crack-"] = minus
-    elif crack is not None:
-        p, tri, plus, minus = _split_crack(p, tri, edges.pop("crack"), mouth, tip)
+    if crack is not None:
+        p, tri, plus, minus = split_body_crack(p, tri, edges.pop("crack"), gear, crack)
         edges["crack+"] = plus
         edges["crack-"] = minus
     return BodyMesh(p=p, t=tri, edges=edges, offsets=offsets, gear=gear, crack=crack,
@@ -617,6 +601,33 @@ def _orient_by_radius(p: np.ndarray, seg: np.ndarray) -> np.ndarray:
     seg[:, flip] = seg[::-1, flip]
     order = np.argsort(r[seg[0]])
     return seg[:, order]
+
+
+def embed_crack(geo, gear: Gear, crack: CrackGeometry, mouth_tag: int, lc: float
+                ) -> tuple[list[int], int]:
+    """gmsh (``gmsh.model.geo``): the crack's lines from the mouth point ``mouth_tag``, one
+    line for a straight crack or one per segment of its path; returns ``(lines, tip tag)``."""
+    tags = [mouth_tag] + [geo.addPoint(float(x), float(y), 0.0, lc)
+                          for x, y in crack_polyline(gear, crack)[1:]]
+    return [geo.addLine(a, b) for a, b in zip(tags[:-1], tags[1:], strict=True)], tags[-1]
+
+
+def split_body_crack(p: np.ndarray, t: np.ndarray, seg: np.ndarray, gear: Gear,
+                     crack: CrackGeometry) -> tuple[np.ndarray, np.ndarray, np.ndarray,
+                                                     np.ndarray]:
+    """Free the crack faces of a meshed body: the straight-line split for a straight crack
+    (:func:`_split_crack`), the topological polyline split for a path
+    (:func:`.crack_mesh.split_crack`). Returns ``p, t, plus, minus``."""
+    mouth, tip = crack_segment(gear, crack)
+    if not crack.path:
+        return _split_crack(p, t, seg, mouth, tip)
+    from .crack_mesh import split_crack
+
+    nodes = np.unique(seg)
+    d_tip = np.hypot(*(p[:, nodes] - tip[:, None]))
+    if d_tip.min() > 1e-9:
+        raise NumericalError("crack tip node not found in the mesh")
+    return split_crack(p, t, seg, [int(nodes[np.argmin(d_tip)])], crack_polyline(gear, crack))
 
 
 def _split_crack(p: np.ndarray, t: np.ndarray, seg: np.ndarray, mouth: np.ndarray,

@@ -51,11 +51,13 @@ from .mesh import (
     MeshSettings,
     _orient_by_radius,
     _rot,
-    _split_crack,
     check_cut,
+    crack_polyline,
     crack_segment,
     cut_flank,
+    embed_crack,
     loaded_flank,
+    split_body_crack,
     tooth_offsets,
 )
 from .solve import BodyInfluence, ElasticBody, ElasticMaterial, _isfloat
@@ -87,9 +89,6 @@ def build_part_mesh(gear: Gear, settings: MeshSettings, part: str, *,
 
     if part not in ("H", "R"):
         raise InputError("part", part, "'H' or 'R'")
-    if crack is not None and crack.path:
-        raise InputError("stiffness.fe.substructure", True,
-                         "false for a crack path (substructuring meshes straight cracks)")
     if part == "H" and (crack is not None or cut_radius is not None):
         raise InputError("part", part, "'R' for a crack or a cut (faults live in R)")
     z = gear.teeth
@@ -104,10 +103,15 @@ def build_part_mesh(gear: Gear, settings: MeshSettings, part: str, *,
     mouth = tip = None
     if crack is not None:
         mouth, tip = crack_segment(gear, crack)
-        if np.hypot(*tip) < r_g + settings.tooth_size:
-            raise InputError("crack.depth", crack.depth,
-                             f"a crack whose tip stays above the interface radius {r_g:.4g} m "
-                             "(plus one tooth element) for substructuring")
+        poly = crack_polyline(gear, crack)
+        polar = np.arctan2(poly[:, 1], poly[:, 0])
+        outside = np.any((polar <= math.pi / 2 - math.pi / z) | (polar >= math.pi / 2 + math.pi / z))
+        if np.min(np.hypot(*poly.T)) < r_g + settings.tooth_size or outside:
+            raise InputError("crack.path" if crack.path else "crack.depth",
+                             crack.path or crack.depth,
+                             f"a crack that stays above the interface radius {r_g:.4g} m (plus "
+                             "one tooth element) and within the faulty tooth's sector for "
+                             "substructuring")
     inv_cut = None
     if cut_radius is not None:
         check_cut(gear, cut_radius)
@@ -211,14 +215,13 @@ def build_part_mesh(gear: Gear, settings: MeshSettings, part: str, *,
                 bore = [geo.addCircleArc(pbore[i], centre, pbore[(i + 1) % 3]) for i in range(3)]
                 named["bore"] = bore
                 surf = geo.addPlaneSurface([outer, geo.addCurveLoop(bore)])
-            crack_line = p_tip = None
+            crack_lines, p_tip = [], None
             if crack is not None:
-                p_tip = geo.addPoint(float(tip[0]), float(tip[1]), 0.0, lc)
-                crack_line = geo.addLine(crack_mouth_tag, p_tip)
+                crack_lines, p_tip = embed_crack(geo, gear, crack, crack_mouth_tag, lc)
             geo.synchronize()
-            if crack_line is not None:
-                gmsh.model.mesh.embed(1, [crack_line], 2, surf)
-                named["crack"] = [crack_line]
+            if crack_lines:
+                gmsh.model.mesh.embed(1, crack_lines, 2, surf)
+                named["crack"] = crack_lines
 
             fld = gmsh.model.mesh.field
             g = settings.growth
@@ -250,7 +253,7 @@ def build_part_mesh(gear: Gear, settings: MeshSettings, part: str, *,
                 fld.setNumber(t2, "DistMin", gear.module)
                 fld.setNumber(t2, "DistMax", gear.module + (hb - ht) / (g - 1))
                 fields += [t1, t2]
-            if crack_line is not None:
+            if crack_lines:
                 f3 = fld.add("Distance")
                 fld.setNumbers(f3, "PointsList", [p_tip])
                 t3 = fld.add("Threshold")
@@ -260,7 +263,7 @@ def build_part_mesh(gear: Gear, settings: MeshSettings, part: str, *,
                 fld.setNumber(t3, "DistMin", 2 * hf)
                 fld.setNumber(t3, "DistMax", 2 * hf + (hb - hf) / (g - 1))
                 f4 = fld.add("Distance")
-                fld.setNumbers(f4, "CurvesList", [crack_line])
+                fld.setNumbers(f4, "CurvesList", crack_lines)
                 fld.setNumber(f4, "Sampling", 200)
                 t4 = fld.add("Threshold")
                 fld.setNumber(t4, "InField", f4)
@@ -312,7 +315,7 @@ def build_part_mesh(gear: Gear, settings: MeshSettings, part: str, *,
         edges[f"flank{j}"] = _orient_by_radius(p, edges[f"flank{j}"])
     edges.setdefault("bore", np.zeros((2, 0), dtype=np.int64))
     if crack is not None:
-        p, tri, plus, minus = _split_crack(p, tri, edges.pop("crack"), mouth, tip)
+        p, tri, plus, minus = split_body_crack(p, tri, edges.pop("crack"), gear, crack)
         edges["crack+"] = plus
         edges["crack-"] = minus
     return BodyMesh(p=p, t=tri, edges=edges, offsets=tuple(mine), gear=gear, crack=crack,
