@@ -107,7 +107,7 @@ def _surface(body: ElasticBody, names: list[str]):
 
 def _points_of(body: ElasticBody, seg: np.ndarray, fac: np.ndarray):
     """All P2 surface nodes of segments: coordinates (body frame) and their (2,) dofs."""
-    nd, fd = body.basis.nodal_dofs, body.basis.facet_dofs
+    nd, fd = body.dof_basis.nodal_dofs, body.dof_basis.facet_dofs
     verts = np.unique(seg)
     xs = [body.mesh.p[:, verts], 0.5 * (body.mesh.p[:, seg[0]] + body.mesh.p[:, seg[1]])]
     dofs = [nd[:, verts], fd[:, fac]]
@@ -228,8 +228,8 @@ def direct_contact(pinion: ElasticBody, gear: ElasticBody, pair, theta: float, d
     gap = np.zeros(n)
     arm = np.zeros(n)
     pair_of = np.zeros(n, dtype=np.int64)
-    nd1, fd1 = pinion.basis.nodal_dofs, pinion.basis.facet_dofs
-    nd2, fd2 = gear.basis.nodal_dofs, gear.basis.facet_dofs
+    nd1, fd1 = pinion.dof_basis.nodal_dofs, pinion.dof_basis.facet_dofs
+    nd2, fd2 = gear.dof_basis.nodal_dofs, gear.dof_basis.facet_dofs
 
     def edge_weights(t):
         return np.array([(1 - t) * (1 - 2 * t), t * (2 * t - 1), 4 * t * (1 - t)])

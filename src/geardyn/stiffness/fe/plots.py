@@ -100,7 +100,7 @@ def plot_body_mesh(case, *, cracked: bool = True, zoom: bool = True,
             load = body.patch_loads(0, np.array([u]), settings.half_width)[:, 0]
             load *= settings.torque / gear.base_radius / case.pair.face_width
             x = body.solve(load)
-            disp = np.vstack([x[body.basis.nodal_dofs[0]], x[body.basis.nodal_dofs[1]]])
+            disp = np.vstack([x[body.dof_basis.nodal_dofs[0]], x[body.dof_basis.nodal_dofs[1]]])
             scale = 0.05 * r / max(np.max(np.hypot(*disp)), 1e-30)
         draw_mesh(axes[1], mesh, (c[0] - r, c[0] + r, c[1] - r, c[1] + r), displacement=disp,
                   scale=scale, linewidth=0.35)

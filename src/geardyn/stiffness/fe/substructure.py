@@ -363,17 +363,17 @@ def _gamma_dofs(body: ElasticBody) -> tuple[np.ndarray, np.ndarray]:
     """DOFs on ``Gamma`` (P2 vertex and midside, both components) and their locations [m]."""
     seg = body.mesh.edges["gamma"]
     fac = body.facet_index(seg)
-    d = np.unique(np.concatenate([body.basis.nodal_dofs[:, np.unique(seg)].ravel(),
-                                  body.basis.facet_dofs[:, fac].ravel()]))
-    return d, body.basis.doflocs[:, d]
+    d = np.unique(np.concatenate([body.dof_basis.nodal_dofs[:, np.unique(seg)].ravel(),
+                                  body.dof_basis.facet_dofs[:, fac].ravel()]))
+    return d, body.dof_basis.doflocs[:, d]
 
 
 def _component(body: ElasticBody, dofs: np.ndarray) -> np.ndarray:
     comp = np.full(body.n_dofs, -1)
-    comp[body.basis.nodal_dofs[0]] = 0
-    comp[body.basis.nodal_dofs[1]] = 1
-    comp[body.basis.facet_dofs[0]] = 0
-    comp[body.basis.facet_dofs[1]] = 1
+    comp[body.dof_basis.nodal_dofs[0]] = 0
+    comp[body.dof_basis.nodal_dofs[1]] = 1
+    comp[body.dof_basis.facet_dofs[0]] = 0
+    comp[body.dof_basis.facet_dofs[1]] = 1
     return comp[dofs]
 
 
