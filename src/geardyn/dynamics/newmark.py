@@ -849,5 +849,21 @@ def _dataset(case, dyn: DynamicModel, stiffness_map: StiffnessMap, which: str,
         from ..modifications import ToothModifications
 
         attrs["tooth_errors"] = ToothModifications.from_case(case).describe()
-    return xr.Dataset(data, coords={"time": ("time", t, {"units": "s", "long_name": "time"})},
-                      attrs=attrs)
+    return owning(xr.Dataset(data, coords={"time": ("time", t, {"units": "s",
+                                                                "long_name": "time"})},
+                             attrs=attrs))
+
+
+def owning(ds):
+    """``ds`` with every variable holding its own array (in place; returned).
+
+    A column of the kernel's record buffer is a view that keeps the whole buffer (every
+    recorded quantity) alive as long as the record: the paper's run held 92 MB of such
+    buffers (issue 16, peak memory). A variable that is a view gets a copy.
+    """
+    for name in ds.data_vars:
+        var = ds[name].variable
+        values = var.values
+        if isinstance(values, np.ndarray) and values.base is not None:
+            var.values = np.array(values)
+    return ds

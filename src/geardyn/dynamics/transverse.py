@@ -591,7 +591,7 @@ def transverse_dataset(case, setup: TransverseSetup, stiffness_map: StiffnessMap
                        static, rows: np.ndarray, n_settle: int, decim: int, complete: bool):
     """The record as an :class:`xarray.Dataset`: the 6-DOF record's variables and metadata
     (:func:`geardyn.dynamics.newmark._dataset`) plus the transverse ones."""
-    from .newmark import _dataset
+    from .newmark import _dataset, owning
 
     tm = setup.model
     nd = setup.nd
@@ -659,4 +659,4 @@ def transverse_dataset(case, setup: TransverseSetup, stiffness_map: StiffnessMap
         ds.attrs[f"bearing_{key}"] = val
         ds.attrs[f"bearing_{key}_units"] = "N/m" if key.startswith("k") else "N s/m"
     del t
-    return ds
+    return owning(ds)
