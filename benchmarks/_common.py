@@ -63,3 +63,69 @@ def best_time(fn: Callable[[], object], repeat: int = 3, number: int = 1) -> flo
             fn()
         best = min(best, (time.perf_counter() - t0) / number)
     return best
+
+
+def _tree_rss_kb(root: int) -> int:
+    """Resident memory [kB] of ``root`` and all its descendants now (Linux ``/proc``)."""
+    import os
+
+    parent: dict[int, int] = {}
+    rss: dict[int, int] = {}
+    for entry in os.listdir("/proc"):
+        if not entry.isdigit():
+            continue
+        try:
+            with open(f"/proc/{entry}/stat") as fh:
+                fields = fh.read().rsplit(")", 1)[1].split()
+            with open(f"/proc/{entry}/statm") as fh:
+                pages = int(fh.read().split()[1])
+        except (OSError, IndexError, ValueError):
+            continue
+        parent[int(entry)] = int(fields[1])
+        rss[int(entry)] = pages * (os.sysconf("SC_PAGE_SIZE") // 1024)
+    tree, frontier = {root}, [root]
+    while frontier:
+        p = frontier.pop()
+        for child, par in parent.items():
+            if par == p and child not in tree:
+                tree.add(child)
+                frontier.append(child)
+    return sum(rss.get(p, 0) for p in tree)
+
+
+def run_measured(cmd: list[str], env: dict, *, interval: float = 0.05
+                 ) -> tuple[float, float, float]:
+    """Run ``cmd``; return its wall time [s], the peak of the *summed* resident memory of the
+    process and its children [MB] (sampled every ``interval`` s from ``/proc``; 0 where there
+    is none) and its own peak resident set [MB] (``ru_maxrss`` from ``wait4``: the largest single
+    process of the tree, not their sum).
+
+    Raises ``RuntimeError`` with the command's stderr if it fails.
+    """
+    import os
+    import subprocess
+    import tempfile
+    import threading
+
+    peak = [0]
+    t0 = time.perf_counter()
+    with tempfile.TemporaryFile() as err:
+        p = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=err)
+        done = threading.Event()
+
+        def sample() -> None:
+            while not done.is_set():
+                if os.path.isdir("/proc"):
+                    peak[0] = max(peak[0], _tree_rss_kb(p.pid))
+                done.wait(interval)
+
+        th = threading.Thread(target=sample, daemon=True)
+        th.start()
+        _, status, usage = os.wait4(p.pid, 0)
+        wall = time.perf_counter() - t0
+        done.set()
+        th.join()
+        if os.waitstatus_to_exitcode(status) != 0:
+            err.seek(0)
+            raise RuntimeError(f"{' '.join(cmd)} failed:\n{err.read().decode()}")
+    return wall, peak[0] / 1024.0, usage.ru_maxrss / 1024.0

@@ -7,6 +7,9 @@ import os
 import pytest
 
 os.environ.setdefault("MPLBACKEND", "Agg")
+# FE bodies in one process (tests/fe/test_background_bodies.py turns the second one on): two
+# test workers each starting a second FE process would oversubscribe the CI machine's two cores
+os.environ.setdefault("GEARDYN_FE_PROCESSES", "0")
 
 
 @pytest.fixture(autouse=True, scope="session")

@@ -114,3 +114,61 @@ def test_ctrl_c_during_a_command_leaves_no_partial_output(tmp_path, command):
     else:
         assert not list(target.glob("*.nc")) if target.exists() else True
     assert not _tmp_files(tmp_path)
+
+
+def _children(pid: int) -> list[int]:
+    """Process ids whose parent is ``pid`` (Linux ``/proc``)."""
+    kids = []
+    for entry in os.listdir("/proc"):
+        if entry.isdigit():
+            try:
+                with open(f"/proc/{entry}/stat") as fh:
+                    fields = fh.read().rsplit(")", 1)[1].split()
+            except OSError:
+                continue
+            if int(fields[1]) == pid:
+                kids.append(int(entry))
+    return kids
+
+
+@pytest.mark.skipif(not os.path.isdir("/proc"), reason="reads the process table from /proc")
+def test_ctrl_c_to_the_group_while_a_second_process_builds_fe_bodies(tmp_path):
+    """A terminal's Ctrl-C reaches every process of the group: the second FE process (which
+    ignores it from its first instruction) prints nothing and is stopped by the first, which
+    reports the interruption as usual."""
+    env = dict(os.environ, GEARDYN_CACHE_DIR=str(tmp_path / "cache"), GEARDYN_FE_PROCESSES="1",
+               GEARDYN_TEST_READY_FILE=str(tmp_path / "ready"))
+    target = tmp_path / "stf"
+    p = subprocess.Popen([sys.executable, "-m", "geardyn", "stiffness", "--method", "fe",
+                          "--out", str(target)], env=env, stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, text=True, start_new_session=True)
+    ready, t0, kids = tmp_path / "ready", time.time(), []
+    while True:
+        started = ready.read_text().splitlines() if ready.exists() else []
+        kids = _children(p.pid)
+        if any(s.startswith("fe map, healthy") for s in started) and kids:
+            break
+        if p.poll() is not None or time.time() - t0 > 300:
+            p.kill()
+            pytest.fail(f"no second FE process seen before the end: {p.communicate()[1][-500:]}")
+        time.sleep(0.02)
+    time.sleep(0.3)  # inside the second process's imports or its body, not at its first line
+    os.killpg(p.pid, signal.SIGINT)
+    _, stderr = p.communicate(timeout=120)
+    assert p.returncode in INTERRUPTED, stderr[-500:]
+    assert "Traceback" not in stderr and "KeyboardInterrupt" not in stderr, stderr[-1500:]
+    assert "re-run the same command" in stderr
+    deadline = time.time() + 10
+    while any(os.path.exists(f"/proc/{k}") and _children(p.pid) for k in kids) and \
+            time.time() < deadline:
+        time.sleep(0.1)
+    alive = []
+    for k in kids:
+        try:
+            with open(f"/proc/{k}/stat") as fh:
+                if fh.read().rsplit(")", 1)[1].split()[0] != "Z":
+                    alive.append(k)
+        except OSError:
+            continue
+    assert not alive, f"second process still running: {alive}"
+    assert not list(target.glob("*.nc")) if target.exists() else True

@@ -3,6 +3,7 @@ paper's Fig. 5 and Fig. 6 analogues."""
 
 from __future__ import annotations
 
+import contextlib
 import json
 import warnings
 from pathlib import Path
@@ -93,7 +94,14 @@ def stiffness(
     from ..stiffness.plots import fig_crack, fig_load_sharing, fig_stiffness
 
     maps = {}
-    with progress_bar() as bar, warnings.catch_warnings(), record_lookups() as lookups:
+    if method == "fe":  # a second process builds the faulty bodies meanwhile, where cores and
+        from ..stiffness.fe.background import faulty_bodies_in_background  # memory allow
+
+        background = faulty_bodies_in_background(case, method=method)
+    else:
+        background = contextlib.nullcontext(None)
+    with progress_bar() as bar, warnings.catch_warnings(), record_lookups() as lookups, \
+            background:
         # the maps carry their validity notes in attrs["warnings"]; printed below once
         warnings.simplefilter("ignore", UserWarning)
         progress = StageProgress(bar)

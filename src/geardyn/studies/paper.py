@@ -102,6 +102,18 @@ def _build_map_with_progress(build_map, case: Case, cracked: bool, result: Study
     return m
 
 
+def _faulty_bodies_in_background(case: Case):
+    """:func:`geardyn.stiffness.fe.background.faulty_bodies_in_background`, imported only for
+    the FE method (the FE package takes 0.2 s to import)."""
+    import contextlib
+
+    if case.stiffness.method != "fe":
+        return contextlib.nullcontext(None)
+    from ..stiffness.fe.background import faulty_bodies_in_background
+
+    return faulty_bodies_in_background(case)
+
+
 class _ImportedOnCall:
     """The function ``module.name``, imported when called.
 
@@ -140,7 +152,9 @@ def stiffness_stage(case: Case, out: Path, result: StudyResult) -> None:
         result.notes.append("--quick: the stiffness maps are coarser than the case's ("
                             + ", ".join(what) + "); run without --quick for the case's own "
                             "maps.")
-    with warnings.catch_warnings():
+    with warnings.catch_warnings(), _faulty_bodies_in_background(map_case):
+        # (a second process builds the cracked map's FE bodies meanwhile, where cores and
+        # memory allow: geardyn.stiffness.fe.background)
         warnings.simplefilter("ignore")  # the maps record their warnings in attrs (read below)
         healthy = _build_map_with_progress(build_map, map_case, False, result,
                                            "stiffness (healthy)")
@@ -162,7 +176,10 @@ def stiffness_stage(case: Case, out: Path, result: StudyResult) -> None:
     if case.stiffness.method == "fe":
         # imported only to draw: the FE package takes 0.2 s to import (issue 16)
         plot_mesh = _ImportedOnCall("geardyn.stiffness.fe", "plot_mesh")
-        result.figures.cached("fig_fe_mesh", plot_mesh, case,
+        # the mesh the maps were built on (with --quick, the coarser one, which is also the one
+        # build_body_mesh has just made and still holds)
+        result.summary["fe_mesh_refinement"] = float(map_case.stiffness.fe.refinement)
+        result.figures.cached("fig_fe_mesh", plot_mesh, map_case,
                               cracked=case.crack is not None and case.crack.active)
     cracks = case.crack is not None and case.crack.active
     dd_op = result.summary.get("static", {}).get("centre_distance_change_mm", 0.0) * 1e-3

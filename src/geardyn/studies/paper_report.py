@@ -581,7 +581,10 @@ def report_stage(case: Case, out: Path, result: StudyResult) -> None:
     if mm:
         rep.table(["centre distance change", "mean k_mb [N/m]"], list(mm.items()),
                   caption="Mean mesh stiffness over a revolution (healthy)")
-    fig("fig_fe_mesh", "Finite-element mesh of the cracked tooth (zoom).")
+    fig("fig_fe_mesh", "Finite-element mesh of the cracked tooth (zoom): the mesh the "
+                       "stiffness maps were computed on"
+                       + (f" (--quick: refinement {s['fe_mesh_refinement']:g})"
+                          if result.quick and "fe_mesh_refinement" in s else "") + ".")
     fig("fig5_stiffness", "Fig. 5a analogue: combined torsional mesh stiffness K_t [N m/rad] "
                           "against pinion rolling angle for centre distance changes 0, 0.5, 1 mm.")
     fig("fig5_load_sharing", "Fig. 5b analogue: load sharing ratio of one tooth pair.")

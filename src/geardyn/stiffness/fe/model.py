@@ -343,11 +343,15 @@ class FEStiffness:
         Replaces the geometry of the case's one root crack, e.g. by a grown crack path
         (:func:`geardyn.faults.tooth_growth.crack_at`); the case must have exactly one root
         crack, through the face, and ``cracked`` must be true.
+    faulty_first : bool
+        Build (or load) the faulty bodies before the healthy ones (what the second process of
+        :mod:`.background` does while the first builds the healthy map). Same result.
     """
 
     def __init__(self, case, *, cracked: bool = True, cache=None,
                  progress: Callable[[int, int], None] | None = None, n_points: int = 48,
-                 settings: FESettings | None = None, crack: CrackGeometry | None = None):
+                 settings: FESettings | None = None, crack: CrackGeometry | None = None,
+                 faulty_first: bool = False):
         from ...faults import faults_from_case
         from .faults import body_faults, check_fe_faults, face_bands
 
@@ -386,7 +390,8 @@ class FEStiffness:
                 jobs.append((name, gears[which], bk[0] if crack is None else crack, bk[1]))
         self.influence: dict[str, BodyInfluence] = {}
         self.from_cache: dict[str, bool] = {}
-        for k, (name, gear, cr, cut) in enumerate(jobs):
+        order = jobs[2:] + jobs[:2] if faulty_first else jobs
+        for k, (name, gear, cr, cut) in enumerate(order):
             inf, hit = body_influence(gear, mat, self.settings, cr, cache=cache,
                                       cut_radius=cut)
             self.influence[name] = inf

@@ -1,0 +1,167 @@
+"""The faulty bodies of an FE map built by a second process while the first builds the healthy
+ones (issue 16.3: "the bodies built in parallel where cores allow").
+
+A cold pair of FE maps (healthy and faulty) solves three bodies one after the other: the healthy
+pinion and gear, then the faulty body (the cracked pinion, loaded on every refined tooth, the
+largest of the three). SuperLU holds the interpreter lock, so threads cannot overlap them; a
+second *process* can. :func:`faulty_bodies_in_background` starts one that builds the faulty map's
+bodies, faulty body first, into the disk cache, while the caller builds the healthy map. Each
+body's cache entry has a lock (:meth:`geardyn.cache.Cache.get_or_build`): whichever process comes
+to a body first builds it, the other waits for it and loads it. So the results are the same
+bytes as a one-process build, whatever the timing (``tests/fe/test_background_bodies.py``).
+
+It costs memory: two bodies are factorised at once (about 400 MB each for the paper's 150,880-DOF
+pinion). The second process starts only when
+
+* the case's stiffness method is ``fe``, its faulty map is not cached yet and it has a faulty
+  body (a crack or a breakage), and the disk cache is on;
+* ``GEARDYN_FE_PROCESSES`` allows it: ``0`` never, ``1`` always, unset (the default) when the
+  machine has at least 2 cores and at least :data:`MIN_AVAILABLE_BYTES` of available memory.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+
+__all__ = ["faulty_bodies_in_background", "BackgroundBodies", "fe_processes",
+           "FE_PROCESSES_ENV", "MIN_AVAILABLE_BYTES"]
+
+#: Environment variable: 0 (one process), 1 (a second process builds the faulty bodies).
+FE_PROCESSES_ENV = "GEARDYN_FE_PROCESSES"
+
+#: Available memory [bytes] below which the default is one process (two paper bodies factorised
+#: at once peak at about 1.2 GB for the whole ``geardyn run``, measured 2026-11-26).
+MIN_AVAILABLE_BYTES = 3 * 1024 ** 3
+
+
+def _available_memory() -> int | None:
+    """``MemAvailable`` of ``/proc/meminfo`` [bytes], or None where there is none."""
+    try:
+        with open("/proc/meminfo", encoding="ascii") as fh:
+            for line in fh:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        return None
+    return None
+
+
+def fe_processes() -> int:
+    """1 if a second process may build FE bodies, else 0 (see the module docstring).
+
+    Raises
+    ------
+    ValueError
+        ``GEARDYN_FE_PROCESSES`` set to anything but 0 or 1 (the message names the variable,
+        its value and what is allowed).
+    """
+    raw = os.environ.get(FE_PROCESSES_ENV)
+    if raw is not None and raw.strip() != "":
+        if raw.strip() not in ("0", "1"):
+            raise ValueError(f"{FE_PROCESSES_ENV}={raw!r} is not allowed: 0 (build the FE "
+                             "bodies in one process) or 1 (a second process builds the faulty "
+                             "map's bodies)")
+        return int(raw.strip())
+    if (os.cpu_count() or 1) < 2:
+        return 0
+    avail = _available_memory()
+    return 0 if avail is not None and avail < MIN_AVAILABLE_BYTES else 1
+
+
+def _build_faulty_bodies(case) -> None:
+    """In the second process: the faulty map's bodies into the cache, faulty body first."""
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the first process's business
+    from .model import FEStiffness
+
+    FEStiffness(case, cracked=True, faulty_first=True)
+
+
+def _start_ignoring_ctrl_c(proc) -> None:
+    """Start ``proc`` with Ctrl-C ignored from its first instruction: a new interpreter keeps
+    an ignored SIGINT ignored, so a Ctrl-C while it imports prints no traceback of it (the
+    first process reports the interruption and stops it)."""
+    import signal
+
+    try:
+        old = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    except ValueError:  # not the main thread: start it as it is
+        proc.start()
+        return
+    try:
+        proc.start()
+    finally:
+        signal.signal(signal.SIGINT, old)
+
+
+def _wanted(case, cache, method: str) -> bool:
+    """Whether a second process would build something: see the module docstring."""
+    if method != "fe" or not cache.enabled or fe_processes() == 0:
+        return False
+    from ...cache import cache_key
+    from ...faults import faults_from_case
+    from .. import map_inputs
+
+    faults = [f for f in faults_from_case(case) if not f.is_null()]
+    if not any(f.kind in ("root_crack", "breakage") for f in faults):
+        return False  # no faulty body: the faulty map uses the healthy bodies
+    key = cache_key(map_inputs(case, "fe", True))
+    return not cache.path("stiffness", key, ".nc").exists()
+
+
+class BackgroundBodies:
+    """What :func:`faulty_bodies_in_background` yields.
+
+    Attributes
+    ----------
+    process : multiprocessing.Process or None
+        The second process, None when none was started.
+    """
+
+    __slots__ = ("process",)
+
+    def __init__(self, process):
+        self.process = process
+
+    @property
+    def started(self) -> bool:
+        """Whether a second process was started."""
+        return self.process is not None
+
+    def __bool__(self) -> bool:
+        return self.started
+
+
+@contextlib.contextmanager
+def faulty_bodies_in_background(case, *, method: str | None = None, cache=None):
+    """While the block runs, a second process builds the FE bodies of ``case``'s faulty map
+    into the cache (when that helps and is allowed: module docstring).
+
+    ``method`` is the stiffness method the block builds its maps with (default the case's);
+    anything but ``"fe"`` starts nothing. Yields a :class:`BackgroundBodies`. On leaving the
+    block normally it waits for the process (whose bodies the block has then usually loaded
+    already); on an exception (Ctrl-C included) it stops the process at once. The process's
+    own errors are not raised here: the block builds whatever the process did not, and raises
+    the error itself.
+    """
+    from ...cache import default_cache
+
+    cache = cache or default_cache()
+    proc = None
+    if _wanted(case, cache, method or case.stiffness.method):
+        import multiprocessing
+
+        proc = multiprocessing.get_context("spawn").Process(
+            target=_build_faulty_bodies, args=(case,), name="geardyn-fe-bodies", daemon=True)
+        _start_ignoring_ctrl_c(proc)
+    try:
+        yield BackgroundBodies(proc)
+    except BaseException:
+        if proc is not None:
+            proc.terminate()
+            proc.join(timeout=10)
+        raise
+    if proc is not None:
+        proc.join()

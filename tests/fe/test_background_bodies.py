@@ -1,0 +1,166 @@
+"""A second process builds the faulty map's FE bodies while the first builds the healthy map
+(issue 16.3): the maps are the same bytes as a one-process build, the bodies come from the
+cache the second process filled, it stops at once on an error, and it starts only when it
+helps and is allowed."""
+
+from __future__ import annotations
+
+import os
+import time
+
+import numpy as np
+import pytest
+
+import geardyn
+from geardyn.cache import Cache, record_lookups
+from geardyn.stiffness import build_map
+from geardyn.stiffness.fe import background as bg
+from geardyn.stiffness.fe.background import (
+    FE_PROCESSES_ENV,
+    faulty_bodies_in_background,
+    fe_processes,
+)
+
+#: a small FE case: coarse mesh, few grid lines (the bodies take about a second each)
+SMALL = {"stiffness.method": "fe", "stiffness.fe.refinement": 0.3,
+         "stiffness.centre_distances": 3, "stiffness.nodes_per_segment": 6}
+
+
+@pytest.fixture(scope="module")
+def case():
+    return geardyn.paper_case().with_overrides(SMALL)
+
+
+def _maps(case):
+    return build_map(case, cracked=False), build_map(case, cracked=True)
+
+
+def test_the_second_process_fills_the_cache_and_the_maps_are_the_same_bytes(case, tmp_path,
+                                                                          monkeypatch):
+    monkeypatch.setenv("GEARDYN_CACHE_DIR", str(tmp_path / "one"))
+    monkeypatch.setenv(FE_PROCESSES_ENV, "0")
+    with faulty_bodies_in_background(case) as started:
+        assert not started                                      # not allowed: one process
+        one = _maps(case)
+
+    monkeypatch.setenv("GEARDYN_CACHE_DIR", str(tmp_path / "two"))
+    monkeypatch.setenv(FE_PROCESSES_ENV, "1")
+    with faulty_bodies_in_background(case) as back:
+        assert back.started and back.process.pid != os.getpid()
+        back.process.join(timeout=300)     # let it finish first, so the test does not race it
+        assert back.process.exitcode == 0
+        with record_lookups() as rec:
+            two = _maps(case)
+    fe = [r for r in rec if r["kind"] == "fe"]
+    # every body (healthy and cracked, each map asks for its own) comes from the other process
+    assert len({r["key"] for r in fe}) >= 2 and all(r["hit"] for r in fe), fe
+    for a, b in zip(one, two, strict=True):
+        assert np.array_equal(a.k_mb, b.k_mb) and np.array_equal(a.dd, b.dd)
+        assert a.attrs["inputs_hash"] == b.attrs["inputs_hash"]
+    assert np.min(two[1].k_mb) < 0.97 * np.min(two[0].k_mb)        # the crack is in the second map
+
+
+def test_racing_the_second_process_gives_the_same_maps(case, tmp_path, monkeypatch):
+    """No waiting: whichever process comes to a body first builds it (the entry's lock)."""
+    monkeypatch.setenv("GEARDYN_CACHE_DIR", str(tmp_path / "race"))
+    monkeypatch.setenv(FE_PROCESSES_ENV, "1")
+    with faulty_bodies_in_background(case) as back:
+        assert back.started
+        raced = _maps(case)
+    assert back.process.exitcode == 0
+    monkeypatch.setenv("GEARDYN_CACHE_DIR", str(tmp_path / "alone"))
+    monkeypatch.setenv(FE_PROCESSES_ENV, "0")
+    alone = _maps(case)
+    for a, b in zip(alone, raced, strict=True):
+        assert np.array_equal(a.k_mb, b.k_mb)
+
+
+def test_an_error_in_the_block_stops_the_second_process_at_once(case, tmp_path, monkeypatch):
+    monkeypatch.setenv("GEARDYN_CACHE_DIR", str(tmp_path / "c"))
+    monkeypatch.setenv(FE_PROCESSES_ENV, "1")
+    t0 = time.perf_counter()
+    with pytest.raises(KeyboardInterrupt):
+        with faulty_bodies_in_background(case) as back:
+            assert back.process.is_alive()
+            raise KeyboardInterrupt
+    assert not back.process.is_alive() and back.process.exitcode != 0
+    assert time.perf_counter() - t0 < 15
+
+
+def test_it_starts_only_when_it_helps(case, tmp_path, monkeypatch):
+    monkeypatch.setenv("GEARDYN_CACHE_DIR", str(tmp_path / "c"))
+    monkeypatch.setenv(FE_PROCESSES_ENV, "1")
+    cache = Cache()
+    assert bg._wanted(case, cache, "fe")
+    assert not bg._wanted(case, cache, "pem")                       # no FE bodies
+    healthy = case.with_overrides({"crack.enabled": False})
+    assert not bg._wanted(healthy, cache, "fe")                     # no faulty body
+    monkeypatch.setenv("GEARDYN_NO_CACHE", "1")
+    assert not bg._wanted(case, Cache(), "fe")                      # nowhere to share them
+    monkeypatch.delenv("GEARDYN_NO_CACHE")
+    monkeypatch.setenv(FE_PROCESSES_ENV, "0")
+    assert not bg._wanted(case, cache, "fe")                        # not allowed
+
+
+def test_not_started_when_the_faulty_map_is_cached(case, tmp_path, monkeypatch):
+    monkeypatch.setenv("GEARDYN_CACHE_DIR", str(tmp_path / "c"))
+    monkeypatch.setenv(FE_PROCESSES_ENV, "0")
+    build_map(case, cracked=True)
+    monkeypatch.setenv(FE_PROCESSES_ENV, "1")
+    with faulty_bodies_in_background(case) as back:
+        assert not back.started
+
+
+@pytest.mark.parametrize("value, expected", [("0", 0), ("1", 1), (" 1 ", 1)])
+def test_the_setting(monkeypatch, value, expected):
+    monkeypatch.setenv(FE_PROCESSES_ENV, value)
+    assert fe_processes() == expected
+
+
+@pytest.mark.parametrize("value", ["2", "-1", "yes", "0.5"])
+def test_a_bad_setting_names_the_variable_its_value_and_what_is_allowed(monkeypatch, value):
+    monkeypatch.setenv(FE_PROCESSES_ENV, value)
+    with pytest.raises(ValueError) as info:
+        fe_processes()
+    assert FE_PROCESSES_ENV in str(info.value) and repr(value) in str(info.value)
+    assert "0 (" in str(info.value) and "1 (" in str(info.value)
+
+
+def test_the_default_needs_two_cores_and_the_memory(monkeypatch):
+    monkeypatch.delenv(FE_PROCESSES_ENV, raising=False)
+    big, small = 8 * 1024 ** 3, 1024 ** 3
+    for cores, avail, expected in [(2, big, 1), (1, big, 0), (None, big, 0), (2, small, 0),
+                                   (16, bg.MIN_AVAILABLE_BYTES, 1), (2, None, 1)]:
+        monkeypatch.setattr(os, "cpu_count", lambda c=cores: c)
+        monkeypatch.setattr(bg, "_available_memory", lambda a=avail: a)
+        assert fe_processes() == expected, (cores, avail)
+
+
+def test_available_memory_is_read_from_meminfo():
+    avail = bg._available_memory()
+    if not os.path.exists("/proc/meminfo"):
+        assert avail is None
+    else:
+        assert avail is not None and 0 < avail < 1 << 50
+
+
+def test_geardyn_stiffness_with_the_second_process(tmp_path):
+    """Through the CLI, as a user runs it: the same maps as in one process, no process left."""
+    import subprocess
+    import sys
+
+    import xarray as xr
+
+    sets = [a for k, v in SMALL.items() for a in ("--set", f"{k}={v}")]
+    outs = {}
+    for n in ("1", "0"):
+        env = dict(os.environ, GEARDYN_FE_PROCESSES=n,
+                   GEARDYN_CACHE_DIR=str(tmp_path / f"cache{n}"))
+        out = tmp_path / f"out{n}"
+        r = subprocess.run([sys.executable, "-m", "geardyn", "stiffness", "--method", "fe",
+                            *sets, "--out", str(out)], capture_output=True, text=True, env=env,
+                           timeout=300)
+        assert r.returncode == 0, r.stdout + r.stderr
+        with xr.open_dataset(out / "stiffness_cracked.nc", engine="h5netcdf") as ds:
+            outs[n] = ds["k_mb"].values.copy()
+    np.testing.assert_array_equal(outs["1"], outs["0"])
