@@ -164,3 +164,53 @@ def test_geardyn_stiffness_with_the_second_process(tmp_path):
         with xr.open_dataset(out / "stiffness_cracked.nc", engine="h5netcdf") as ds:
             outs[n] = ds["k_mb"].values.copy()
     np.testing.assert_array_equal(outs["1"], outs["0"])
+
+
+def _mark(path) -> None:
+    """A follow-up task for the second process: write ``path``."""
+    from pathlib import Path
+
+    Path(path).write_text(str(os.getpid()))
+
+
+def test_follow_up_work_runs_after_the_bodies_and_outlives_the_block(case, tmp_path,
+                                                                     monkeypatch):
+    import functools
+
+    monkeypatch.setenv("GEARDYN_CACHE_DIR", str(tmp_path / "c"))
+    monkeypatch.setenv(FE_PROCESSES_ENV, "1")
+    marker = tmp_path / "done"
+    t0 = time.perf_counter()
+    with faulty_bodies_in_background(case, then=(functools.partial(_mark, marker),)) as back:
+        assert back.started
+    assert back.process.is_alive() or marker.exists()   # the block did not wait for the task
+    back.process.join(timeout=300)
+    assert back.process.exitcode == 0
+    assert int(marker.read_text()) == back.process.pid != os.getpid()
+    with record_lookups() as rec:
+        build_map(case, cracked=True)
+    assert all(r["hit"] for r in rec if r["kind"] == "fe")  # the bodies came before the task
+    assert time.perf_counter() - t0 < 300
+
+
+def test_compile_kernels_leaves_the_time_step_kernel_compiled():
+    from geardyn.dynamics import _kernel
+    from geardyn.dynamics.warm import compile_kernels
+
+    seconds = compile_kernels()
+    assert seconds > 0 and _kernel.advance.signatures
+
+
+def _boom() -> None:
+    raise RuntimeError("a follow-up task that fails")
+
+
+def test_an_error_in_the_second_process_ends_it_quietly(case, tmp_path, monkeypatch, capfd):
+    monkeypatch.setenv("GEARDYN_CACHE_DIR", str(tmp_path / "c"))
+    monkeypatch.setenv(FE_PROCESSES_ENV, "1")
+    with faulty_bodies_in_background(case, then=(_boom,)) as back:
+        pass
+    back.process.join(timeout=300)
+    assert back.process.exitcode == 1
+    err = capfd.readouterr().err
+    assert "Traceback" not in err and "a follow-up task that fails" not in err

@@ -109,9 +109,13 @@ def _faulty_bodies_in_background(case: Case):
 
     if case.stiffness.method != "fe":
         return contextlib.nullcontext(None)
+    from ..dynamics.warm import compile_kernels
     from ..stiffness.fe.background import faulty_bodies_in_background
 
-    return faulty_bodies_in_background(case)
+    # after the bodies, the same process compiles the time-step kernel (a first run after an
+    # install; otherwise it loads it in a fraction of a second) while this one evaluates the
+    # maps and draws their figures
+    return faulty_bodies_in_background(case, then=(compile_kernels,))
 
 
 class _ImportedOnCall:

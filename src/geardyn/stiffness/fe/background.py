@@ -69,14 +69,25 @@ def fe_processes() -> int:
     return 0 if avail is not None and avail < MIN_AVAILABLE_BYTES else 1
 
 
-def _build_faulty_bodies(case) -> None:
-    """In the second process: the faulty map's bodies into the cache, faulty body first."""
+def _build_faulty_bodies(case, then: tuple = ()) -> None:
+    """In the second process: the faulty map's bodies into the cache, faulty body first; then
+    each callable of ``then`` (e.g. :func:`geardyn.dynamics.warm.compile_kernels`).
+
+    An error here ends this process quietly (exit status 1): the first process builds whatever
+    is missing and reports the error itself, once.
+    """
     import signal
+    import sys
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the first process's business
-    from .model import FEStiffness
+    try:
+        from .model import FEStiffness
 
-    FEStiffness(case, cracked=True, faulty_first=True)
+        FEStiffness(case, cracked=True, faulty_first=True)
+        for task in then:
+            task()
+    except Exception:  # noqa: BLE001 - reported by the first process, which meets it too
+        sys.exit(1)
 
 
 def _start_ignoring_ctrl_c(proc) -> None:
@@ -135,16 +146,20 @@ class BackgroundBodies:
 
 
 @contextlib.contextmanager
-def faulty_bodies_in_background(case, *, method: str | None = None, cache=None):
+def faulty_bodies_in_background(case, *, method: str | None = None, cache=None,
+                                then: tuple = ()):
     """While the block runs, a second process builds the FE bodies of ``case``'s faulty map
     into the cache (when that helps and is allowed: module docstring).
 
     ``method`` is the stiffness method the block builds its maps with (default the case's);
-    anything but ``"fe"`` starts nothing. Yields a :class:`BackgroundBodies`. On leaving the
-    block normally it waits for the process (whose bodies the block has then usually loaded
-    already); on an exception (Ctrl-C included) it stops the process at once. The process's
-    own errors are not raised here: the block builds whatever the process did not, and raises
-    the error itself.
+    anything but ``"fe"`` starts nothing. ``then``: module-level functions (no arguments) the
+    second process calls after the bodies, e.g. :func:`geardyn.dynamics.warm.compile_kernels`
+    (compiled while the first process evaluates the maps and goes on). Yields a
+    :class:`BackgroundBodies`. On leaving the block normally it waits for the process (whose
+    bodies the block has then usually loaded already), unless there is ``then`` work, which goes
+    on after the block; on an exception (Ctrl-C included) it stops the process at once. The
+    process's own errors are not raised here: the block builds whatever the process did not,
+    and raises the error itself.
     """
     from ...cache import default_cache
 
@@ -154,7 +169,8 @@ def faulty_bodies_in_background(case, *, method: str | None = None, cache=None):
         import multiprocessing
 
         proc = multiprocessing.get_context("spawn").Process(
-            target=_build_faulty_bodies, args=(case,), name="geardyn-fe-bodies", daemon=True)
+            target=_build_faulty_bodies, args=(case, tuple(then)), name="geardyn-fe-bodies",
+            daemon=True)
         _start_ignoring_ctrl_c(proc)
     try:
         yield BackgroundBodies(proc)
@@ -163,5 +179,7 @@ def faulty_bodies_in_background(case, *, method: str | None = None, cache=None):
             proc.terminate()
             proc.join(timeout=10)
         raise
-    if proc is not None:
+    if proc is not None and not then:
         proc.join()
+    # with ``then`` it goes on after the block (that is its point); a daemon, it is stopped if
+    # this process ends first (multiprocessing's exit handler), its unfinished work lost
