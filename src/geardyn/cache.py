@@ -86,6 +86,15 @@ def _entry_lock(path: Path):
         lock.release()
 
 
+def _touch(path: Path) -> None:
+    """Mark an entry as used now (its modification time: ``geardyn cache clear --older-than``
+    removes what was not used for a while). A read-only cache keeps its times."""
+    try:
+        os.utime(path)
+    except OSError:
+        return
+
+
 class Cache:
     """A folder of checksummed entries.
 
@@ -180,6 +189,7 @@ class Cache:
                     try:
                         obj = load(path)
                         _note_lookup(kind, key, True)
+                        _touch(path)
                         return obj, True
                     except Exception:  # unreadable despite checksum (format change), or its
                         self.discard(path)  # content records other inputs: rebuild
@@ -233,6 +243,8 @@ class Cache:
                 hit = self.valid(path, key)
                 if not hit:
                     self.discard(path)
+                else:
+                    _touch(path)
             if not hit:
                 self.store(None, path, key, lambda _obj, tmp: write(tmp))
             with atomic_path(target, suffix=target.suffix) as tmp:

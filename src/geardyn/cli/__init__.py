@@ -58,7 +58,7 @@ def _optional(name: str) -> None:
 
 
 for _name in ("stiffness", "simulate", "diagnose", "sweep", "measure", "static_te",
-              "study", "crack_growth"):
+              "study", "crack_growth", "cache"):
     _optional(_name)
 
 
