@@ -214,3 +214,15 @@ def test_an_error_in_the_second_process_ends_it_quietly(case, tmp_path, monkeypa
     assert back.process.exitcode == 1
     err = capfd.readouterr().err
     assert "Traceback" not in err and "a follow-up task that fails" not in err
+
+
+def test_the_second_process_fills_the_callers_cache(case, tmp_path, monkeypatch):
+    """A cache given by the caller, not the default one, receives the bodies."""
+    monkeypatch.setenv("GEARDYN_CACHE_DIR", str(tmp_path / "default"))
+    monkeypatch.setenv(FE_PROCESSES_ENV, "1")
+    mine = Cache(tmp_path / "mine", enabled=True)
+    with faulty_bodies_in_background(case, cache=mine) as back:
+        back.process.join(timeout=300)
+    assert back.process.exitcode == 0
+    assert len(list((tmp_path / "mine" / "fe").glob("*.npz"))) >= 2
+    assert not (tmp_path / "default" / "fe").exists()

@@ -69,9 +69,10 @@ def fe_processes() -> int:
     return 0 if avail is not None and avail < MIN_AVAILABLE_BYTES else 1
 
 
-def _build_faulty_bodies(case, then: tuple = ()) -> None:
-    """In the second process: the faulty map's bodies into the cache, faulty body first; then
-    each callable of ``then`` (e.g. :func:`geardyn.dynamics.warm.compile_kernels`).
+def _build_faulty_bodies(case, then: tuple = (), cache_root: str | None = None) -> None:
+    """In the second process: the faulty map's bodies into the cache at ``cache_root`` (default
+    :func:`geardyn.cache.cache_dir`), faulty body first; then each callable of ``then`` (e.g.
+    :func:`geardyn.dynamics.warm.compile_kernels`).
 
     An error here ends this process quietly (exit status 1): the first process builds whatever
     is missing and reports the error itself, once.
@@ -81,9 +82,11 @@ def _build_faulty_bodies(case, then: tuple = ()) -> None:
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the first process's business
     try:
+        from ...cache import Cache
         from .model import FEStiffness
 
-        FEStiffness(case, cracked=True, faulty_first=True)
+        cache = None if cache_root is None else Cache(cache_root, enabled=True)
+        FEStiffness(case, cracked=True, faulty_first=True, cache=cache)
         for task in then:
             task()
     except Exception:  # noqa: BLE001 - reported by the first process, which meets it too
@@ -169,8 +172,8 @@ def faulty_bodies_in_background(case, *, method: str | None = None, cache=None,
         import multiprocessing
 
         proc = multiprocessing.get_context("spawn").Process(
-            target=_build_faulty_bodies, args=(case, tuple(then)), name="geardyn-fe-bodies",
-            daemon=True)
+            target=_build_faulty_bodies, args=(case, tuple(then), str(cache.root)),
+            name="geardyn-fe-bodies", daemon=True)
         _start_ignoring_ctrl_c(proc)
     try:
         yield BackgroundBodies(proc)
