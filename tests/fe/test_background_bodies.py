@@ -35,6 +35,7 @@ def _maps(case):
     return build_map(case, cracked=False), build_map(case, cracked=True)
 
 
+@pytest.mark.slow
 def test_the_second_process_fills_the_cache_and_the_maps_are_the_same_bytes(case, tmp_path,
                                                                           monkeypatch):
     monkeypatch.setenv("GEARDYN_CACHE_DIR", str(tmp_path / "one"))
@@ -60,6 +61,7 @@ def test_the_second_process_fills_the_cache_and_the_maps_are_the_same_bytes(case
     assert np.min(two[1].k_mb) < 0.97 * np.min(two[0].k_mb)        # the crack is in the second map
 
 
+@pytest.mark.slow
 def test_racing_the_second_process_gives_the_same_maps(case, tmp_path, monkeypatch):
     """No waiting: whichever process comes to a body first builds it (the entry's lock)."""
     monkeypatch.setenv("GEARDYN_CACHE_DIR", str(tmp_path / "race"))
@@ -75,6 +77,7 @@ def test_racing_the_second_process_gives_the_same_maps(case, tmp_path, monkeypat
         assert np.array_equal(a.k_mb, b.k_mb)
 
 
+@pytest.mark.slow
 def test_an_error_in_the_block_stops_the_second_process_at_once(case, tmp_path, monkeypatch):
     monkeypatch.setenv("GEARDYN_CACHE_DIR", str(tmp_path / "c"))
     monkeypatch.setenv(FE_PROCESSES_ENV, "1")
@@ -102,6 +105,7 @@ def test_it_starts_only_when_it_helps(case, tmp_path, monkeypatch):
     assert not bg._wanted(case, cache, "fe")                        # not allowed
 
 
+@pytest.mark.slow
 def test_not_started_when_the_faulty_map_is_cached(case, tmp_path, monkeypatch):
     monkeypatch.setenv("GEARDYN_CACHE_DIR", str(tmp_path / "c"))
     monkeypatch.setenv(FE_PROCESSES_ENV, "0")
@@ -144,6 +148,7 @@ def test_available_memory_is_read_from_meminfo():
         assert avail is not None and 0 < avail < 1 << 50
 
 
+@pytest.mark.slow
 def test_geardyn_stiffness_with_the_second_process(tmp_path):
     """Through the CLI, as a user runs it: the same maps as in one process, no process left."""
     import subprocess
@@ -173,6 +178,7 @@ def _mark(path) -> None:
     Path(path).write_text(str(os.getpid()))
 
 
+@pytest.mark.slow
 def test_follow_up_work_runs_after_the_bodies_and_outlives_the_block(case, tmp_path,
                                                                      monkeypatch):
     import functools
@@ -193,6 +199,7 @@ def test_follow_up_work_runs_after_the_bodies_and_outlives_the_block(case, tmp_p
     assert time.perf_counter() - t0 < 300
 
 
+@pytest.mark.slow
 def test_compile_kernels_leaves_the_time_step_kernel_compiled():
     from geardyn.dynamics import _kernel
     from geardyn.dynamics.warm import compile_kernels
@@ -205,6 +212,7 @@ def _boom() -> None:
     raise RuntimeError("a follow-up task that fails")
 
 
+@pytest.mark.slow
 def test_an_error_in_the_second_process_ends_it_quietly(case, tmp_path, monkeypatch, capfd):
     monkeypatch.setenv("GEARDYN_CACHE_DIR", str(tmp_path / "c"))
     monkeypatch.setenv(FE_PROCESSES_ENV, "1")
@@ -216,6 +224,7 @@ def test_an_error_in_the_second_process_ends_it_quietly(case, tmp_path, monkeypa
     assert "Traceback" not in err and "a follow-up task that fails" not in err
 
 
+@pytest.mark.slow
 def test_the_second_process_fills_the_callers_cache(case, tmp_path, monkeypatch):
     """A cache given by the caller, not the default one, receives the bodies."""
     monkeypatch.setenv("GEARDYN_CACHE_DIR", str(tmp_path / "default"))
