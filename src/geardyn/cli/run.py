@@ -110,8 +110,12 @@ def _print_summary(s: dict, out: Path, lookups: list | None = None) -> None:
 
     from ._outputs import say_cache
 
+    # a case whose physical inputs differ from the paper's is compared with nothing (as in
+    # its report), and its fault need not be a crack
+    paper = bool(s.get("paper_case", True))
+    faulty = "cracked" if paper else "faulty"
     t = Table(title=f"geardyn run: {escape(str(out))}/", show_lines=False)
-    for col in ("quantity", "geardyn", "paper"):
+    for col in ("quantity", "geardyn", "paper") if paper else ("quantity", "geardyn"):
         t.add_column(col, justify="left" if col == "quantity" else "right")
     cr = s.get("contact_ratio", {})
     rows = [("centre distance change \\[mm]", s.get("centre_distance_change_mm"), "~1.07"),
@@ -121,17 +125,26 @@ def _print_summary(s: dict, out: Path, lookups: list | None = None) -> None:
              "- / 1.43"),
             ("mean pinion speed \\[rad/s]", s.get("mean_pinion_speed_rad_s"), "114.14"),
             ("mean transmission error \\[rad]", s.get("mean_transmission_error_rad"), "0.05"),
-            ("crack seen at \\[deg]", s.get("crack_angle_deg"), "~170")]
-    for label, ours, paper in rows:
+            ("crack seen at \\[deg]" if paper else "fault seen at \\[deg]",
+             s.get("crack_angle_deg"), "~170")]
+    for label, ours, theirs in rows:
         if ours is None:
             continue
-        t.add_row(label, ours if isinstance(ours, str) else f"{ours:.4f}", paper)
+        cells = [label, ours if isinstance(ours, str) else f"{ours:.4f}"]
+        t.add_row(*(cells + [theirs] if paper else cells))
     console.print(t)
     val = s.get("validation", [])
     failed = [v for v in val if not v["pass"]]
-    console.print(f"validation against the paper: {len(val) - len(failed)}/{len(val)} within "
-                  f"tolerance; stages: {', '.join(s.get('stages', []))} "
-                  f"({s.get('run_time_s', {}).get('total', float('nan')):.1f} s)")
+    stages = (f"stages: {', '.join(s.get('stages', []))} "
+              f"({s.get('run_time_s', {}).get('total', float('nan')):.1f} s)")
+    if paper:
+        console.print(f"validation against the paper: {len(val) - len(failed)}/{len(val)} "
+                      f"within tolerance; {stages}")
+    else:
+        keys = [d.get("key", "?") for d in s.get("differences_from_paper", [])]
+        shown = ", ".join(keys[:3]) + (f" and {len(keys) - 3} more" if len(keys) > 3 else "")
+        console.print(f"not the paper's case ({escape(shown) or 'its inputs differ'}): nothing "
+                      f"is compared with the paper; {stages}", highlight=False)
     for v in failed:
         err_console.print(f"[yellow]outside tolerance[/yellow]: {escape(v['quantity'])}: "
                           f"geardyn {v['geardyn']:.4g}, paper {v['paper']:.4g}")
@@ -140,7 +153,7 @@ def _print_summary(s: dict, out: Path, lookups: list | None = None) -> None:
               for k in ("rms_ii_minus_i_static", "rms_ii_minus_i", "explained_fraction")}
     if all(ratios.values()):
         console.print(
-            "model I-static (K at the static centre distance) vs model II, cracked: within "
+            f"model I-static (K at the static centre distance) vs model II, {faulty}: within "
             f"{100 * max(ratios['rms_ii_minus_i_static']):.3g}% of each signal's STD, model I "
             f"{100 * min(ratios['rms_ii_minus_i']):.3g}-{100 * max(ratios['rms_ii_minus_i']):.3g}"
             f"%; the static shift explains {100 * min(ratios['explained_fraction']):.3g}-"
@@ -151,9 +164,10 @@ def _print_summary(s: dict, out: Path, lookups: list | None = None) -> None:
         c = meas["indicators"]["errors+noise"]["cracked"]
         seen = [k for k, r in meas["detections"]["errors+noise"].items() if r["detected"]]
         console.print(f"realistic measurement (housing accelerometer, tooth errors, noise, "
-                      f"model {meas['model']}): FM4 healthy {h['FM4']:.3g} / cracked "
+                      f"model {meas['model']}): FM4 healthy {h['FM4']:.3g} / {faulty} "
                       f"{c['FM4']:.3g}, NA4* {h['NA4star']:.3g} / {c['NA4star']:.3g}, energy "
-                      f"ratio {h['EnergyRatio']:.3g} / {c['EnergyRatio']:.3g}; crack seen by: "
+                      f"ratio {h['EnergyRatio']:.3g} / {c['EnergyRatio']:.3g}; "
+                      f"{'crack' if paper else 'fault'} seen by: "
                       f"{', '.join(seen) or 'none of the indicators'}")
     elif "skipped" in meas:
         err_console.print(f"[yellow]note[/yellow]: realistic-measurement section skipped: "
