@@ -26,3 +26,14 @@ def test_title_lists_faults_by_type_and_place():
     title, _ = _own_case_title(case, case_differences(case)[0])
     assert "faults = [spall on pinion tooth 11]" in title
     assert "None" not in title and "{" not in title
+
+
+def test_the_differences_table_shows_the_fields_a_fault_sets():
+    from geardyn.studies.paper_report import _set_fields
+
+    faults = [{"type": "breakage", "gear": "pinion", "tooth": 11, "depth": None,
+               "height": 0.002},
+              {"type": "spall", "tooth": 3, "width": None, "length": 0.001}]
+    assert _set_fields(faults) == ("type = breakage, gear = pinion, tooth = 11, height = 0.002; "
+                                   "type = spall, tooth = 3, length = 0.001")
+    assert _set_fields(True) is True and _set_fields(None) is None and _set_fields([]) == []

@@ -426,6 +426,15 @@ def _short_value(value) -> str:
     return str(value)
 
 
+def _set_fields(value):
+    """A changed input for the differences table: each entry of a faults list with the fields
+    it sets (SI values), without the many it leaves unset (``None``)."""
+    if isinstance(value, list) and value and all(isinstance(v, dict) for v in value):
+        return "; ".join(", ".join(f"{k} = {v}" for k, v in entry.items() if v is not None)
+                         for entry in value)
+    return value
+
+
 def _own_case_title(case: Case, diffs: list[dict]) -> tuple[str, str]:
     """Title and subtitle of the report of a case that is not the paper's.
 
@@ -526,7 +535,8 @@ def report_stage(case: Case, out: Path, result: StudyResult) -> None:
         rep.paragraph("These inputs differ from Xue & Howard's case (SI values), so this "
                       "report does not compare its results with the paper's.")
         rep.table(["key", "paper's case", "this case"],
-                  [[d["key"], d["paper"], d["case"]] for d in diffs], left_columns=1)
+                  [[d["key"], _set_fields(d["paper"]), _set_fields(d["case"])] for d in diffs],
+                  left_columns=1)
     if numerical:
         rep.table(["numerical setting", "paper case's default", "this run"],
                   [[d["key"], d["paper"], d["case"]] for d in numerical], left_columns=1,
