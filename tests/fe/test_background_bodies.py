@@ -235,3 +235,52 @@ def test_the_second_process_fills_the_callers_cache(case, tmp_path, monkeypatch)
     assert back.process.exitcode == 0
     assert len(list((tmp_path / "mine" / "fe").glob("*.npz"))) >= 2
     assert not (tmp_path / "default" / "fe").exists()
+
+
+UNGUARDED = """
+import geardyn
+from geardyn.stiffness import build_map
+from geardyn.stiffness.fe.background import faulty_bodies_in_background
+print("top level ran", flush=True)
+case = geardyn.paper_case().with_overrides({overrides!r})
+with faulty_bodies_in_background(case) as bg:
+    build_map(case, cracked=False)
+    build_map(case, cracked=True)
+bg.process.join()
+print("second process exit", bg.process.exitcode, flush=True)
+"""
+
+
+@pytest.mark.slow
+def test_a_users_script_without_a_main_guard_runs_once(tmp_path):
+    """The second process does not import the user's script (which would run its top level
+    again, and fail with multiprocessing's bootstrapping error without a main guard)."""
+    import subprocess
+    import sys
+
+    script = tmp_path / "script.py"
+    script.write_text(UNGUARDED.format(overrides=SMALL))
+    env = dict(os.environ, GEARDYN_FE_PROCESSES="1", GEARDYN_CACHE_DIR=str(tmp_path / "c"))
+    r = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, env=env,
+                       timeout=300, cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.count("top level ran") == 1, r.stdout
+    assert "second process exit 0" in r.stdout, r.stdout + r.stderr
+    assert "Traceback" not in r.stderr and "RuntimeError" not in r.stderr, r.stderr[-1500:]
+
+
+def test_the_main_module_is_put_back():
+    import __main__
+
+    def state():
+        return ("__spec__" in vars(__main__), vars(__main__).get("__spec__"),
+                "__file__" in vars(__main__), vars(__main__).get("__file__"))
+
+    before = state()
+    with bg._without_main_module():
+        assert getattr(__main__, "__spec__", None) is None and "__file__" not in vars(__main__)
+    assert state() == before
+    with pytest.raises(KeyError):
+        with bg._without_main_module():
+            raise KeyError("an error while starting")
+    assert state() == before

@@ -17,6 +17,10 @@ pinion). The second process starts only when
   body (a crack or a breakage), and the disk cache is on;
 * ``GEARDYN_FE_PROCESSES`` allows it: ``0`` never, ``1`` always, unset (the default) when the
   machine has at least 2 cores and at least :data:`MIN_AVAILABLE_BYTES` of available memory.
+
+The second process is spawned (a fresh interpreter, nothing of this one's threads or locks),
+ignores Ctrl-C, and does not import the caller's main script: a user's script without an
+``if __name__ == "__main__":`` guard runs once.
 """
 
 from __future__ import annotations
@@ -93,21 +97,53 @@ def _build_faulty_bodies(case, then: tuple = (), cache_root: str | None = None) 
         sys.exit(1)
 
 
-def _start_ignoring_ctrl_c(proc) -> None:
-    """Start ``proc`` with Ctrl-C ignored from its first instruction: a new interpreter keeps
-    an ignored SIGINT ignored, so a Ctrl-C while it imports prints no traceback of it (the
-    first process reports the interruption and stops it)."""
+@contextlib.contextmanager
+def _without_main_module():
+    """While starting a spawned process, hide where ``__main__`` came from.
+
+    A spawned process imports the parent's main script (as ``__mp_main__``) unless told
+    nothing about it; a user's script without an ``if __name__ == "__main__":`` guard would run
+    again there and fail with multiprocessing's bootstrapping error. The second process runs
+    geardyn's code only, so it needs nothing from ``__main__``: its ``__spec__`` and
+    ``__file__`` (what :func:`multiprocessing.spawn.get_preparation_data` reads) are set aside
+    while the process starts, then put back.
+    """
+    import sys
+
+    main = sys.modules.get("__main__")
+    saved = {}
+    if main is not None:
+        for name in ("__spec__", "__file__"):
+            if name in vars(main):
+                saved[name] = vars(main)[name]
+        if "__spec__" in saved:
+            main.__spec__ = None
+        if "__file__" in saved:
+            del main.__file__
+    try:
+        yield
+    finally:
+        for name, value in saved.items():
+            setattr(main, name, value)
+
+
+def _start_quietly(proc) -> None:
+    """Start ``proc`` without the parent's main script (:func:`_without_main_module`) and with
+    Ctrl-C ignored from its first instruction: a new interpreter keeps an ignored SIGINT
+    ignored, so a Ctrl-C while it imports prints no traceback of it (the first process reports
+    the interruption and stops it)."""
     import signal
 
-    try:
-        old = signal.signal(signal.SIGINT, signal.SIG_IGN)
-    except ValueError:  # not the main thread: start it as it is
-        proc.start()
-        return
-    try:
-        proc.start()
-    finally:
-        signal.signal(signal.SIGINT, old)
+    with _without_main_module():
+        try:
+            old = signal.signal(signal.SIGINT, signal.SIG_IGN)
+        except ValueError:  # not the main thread: start it as it is
+            proc.start()
+            return
+        try:
+            proc.start()
+        finally:
+            signal.signal(signal.SIGINT, old)
 
 
 def _wanted(case, cache, method: str) -> bool:
@@ -174,7 +210,7 @@ def faulty_bodies_in_background(case, *, method: str | None = None, cache=None,
         proc = multiprocessing.get_context("spawn").Process(
             target=_build_faulty_bodies, args=(case, tuple(then), str(cache.root)),
             name="geardyn-fe-bodies", daemon=True)
-        _start_ignoring_ctrl_c(proc)
+        _start_quietly(proc)
     try:
         yield BackgroundBodies(proc)
     except BaseException:
