@@ -284,3 +284,26 @@ def test_the_main_module_is_put_back():
         with bg._without_main_module():
             raise KeyError("an error while starting")
     assert state() == before
+
+
+def test_not_started_in_a_daemonic_process_or_when_starting_fails(case, tmp_path, monkeypatch):
+    import multiprocessing
+
+    monkeypatch.setenv("GEARDYN_CACHE_DIR", str(tmp_path / "c"))
+    monkeypatch.setenv(FE_PROCESSES_ENV, "1")
+    cache = Cache()
+    assert bg._wanted(case, cache, "fe")
+
+    class Daemon:
+        daemon = True
+
+    with monkeypatch.context() as m:
+        m.setattr(multiprocessing, "current_process", lambda: Daemon())
+        assert not bg._wanted(case, cache, "fe")   # a pool's worker may not have children
+
+    def refuse(_proc):
+        raise OSError("Resource temporarily unavailable")
+
+    monkeypatch.setattr(bg, "_start_quietly", refuse)
+    with faulty_bodies_in_background(case) as back:
+        assert not back.started                    # one process builds everything

@@ -148,8 +148,12 @@ def _start_quietly(proc) -> None:
 
 def _wanted(case, cache, method: str) -> bool:
     """Whether a second process would build something: see the module docstring."""
+    import multiprocessing
+
     if method != "fe" or not cache.enabled or fe_processes() == 0:
         return False
+    if multiprocessing.current_process().daemon:
+        return False  # a daemonic process (a pool's worker) may not have children
     from ...cache import cache_key
     from ...faults import faults_from_case
     from .. import map_inputs
@@ -210,7 +214,10 @@ def faulty_bodies_in_background(case, *, method: str | None = None, cache=None,
         proc = multiprocessing.get_context("spawn").Process(
             target=_build_faulty_bodies, args=(case, tuple(then), str(cache.root)),
             name="geardyn-fe-bodies", daemon=True)
-        _start_quietly(proc)
+        try:
+            _start_quietly(proc)
+        except (OSError, RuntimeError):  # no process to be had (limits, a frozen program...):
+            proc = None                  # this one builds everything, as with 0
     try:
         yield BackgroundBodies(proc)
     except BaseException:
