@@ -75,16 +75,13 @@ class KindUsage:
     newest: float | None
 
 
-def _entries(cache: Cache, kinds: tuple[str, ...] | None) -> dict[str, list[Path]]:
+def _entries(cache: Cache) -> dict[str, list[Path]]:
+    """Kind (sub-folder) -> its entries' files, sorted."""
     root = cache.root
-    out: dict[str, list[Path]] = {}
     if not root.is_dir():
-        return out
-    for folder in sorted(p for p in root.iterdir() if p.is_dir()):
-        if kinds is not None and folder.name not in kinds:
-            continue
-        out[folder.name] = sorted(p for p in folder.iterdir() if _is_entry(p))
-    return out
+        return {}
+    return {folder.name: sorted(p for p in folder.iterdir() if _is_entry(p))
+            for folder in sorted(p for p in root.iterdir() if p.is_dir())}
 
 
 def _size(path: Path) -> int:
@@ -101,7 +98,7 @@ def cache_usage(cache: Cache | None = None) -> list[KindUsage]:
     """Entries, size and last use of each kind in the cache (sorted by kind)."""
     cache = cache or Cache()
     usage = []
-    for kind, paths in _entries(cache, None).items():
+    for kind, paths in _entries(cache).items():
         times = []
         for p in paths:
             try:
@@ -111,11 +108,6 @@ def cache_usage(cache: Cache | None = None) -> list[KindUsage]:
         usage.append(KindUsage(kind, len(paths), sum(_size(p) for p in paths),
                                min(times) if times else None, max(times) if times else None))
     return usage
-
-
-def known_kinds(cache: Cache | None = None) -> list[str]:
-    """The kinds present in the cache folder."""
-    return [u.kind for u in cache_usage(cache)]
 
 
 @dataclass
@@ -174,8 +166,9 @@ def prune(cache: Cache | None = None, *, kinds: tuple[str, ...] | None = None,
     from filelock import FileLock, Timeout
 
     cache = cache or Cache()
+    all_entries = _entries(cache)
     if kinds is not None:
-        present = known_kinds(cache)
+        present = list(all_entries)
         for k in kinds:
             if k not in present:
                 raise InputError("--kind", k, "one of the kinds in the cache: "
@@ -184,7 +177,6 @@ def prune(cache: Cache | None = None, *, kinds: tuple[str, ...] | None = None,
         raise InputError("--older-than", older_than, "an age >= 0")
     now = time.time() if now is None else now
     result = PruneResult()
-    all_entries = _entries(cache, None)
     for kind, paths in all_entries.items():
         if kinds is not None and kind not in kinds:
             result.kept += len(paths)
