@@ -204,6 +204,11 @@ def test_fe_map_of_the_grown_path_through_the_cli(tmp_path):
     with xr.open_dataset(out / "crack_growth.nc", engine="h5netcdf") as ds:
         ds = ds.load()
     assert ds.attrs["indicator_stiffness"] == "fe"
+    # --quick: the maps of geardyn run --quick (coarse FE mesh, at most 11 centre distances)
+    from geardyn.studies.paper import QUICK_CENTRE_DISTANCES, QUICK_REFINEMENT
+
+    assert ds.attrs["indicator_fe_mesh_refinement"] == QUICK_REFINEMENT
+    assert ds.attrs["indicator_map_centre_distances"] <= QUICK_CENTRE_DISTANCES
     assert "grown crack path" in ds["mesh_stiffness"].attrs["long_name"]
     assert list(ds["simulation_status"].values) == ["ok"] * 2
     k, kh = ds["mesh_stiffness"].values, ds["healthy_mesh_stiffness"].values

@@ -29,10 +29,18 @@ SHORT = ["--quick", "--stiffness", "pem", "--set", "simulation.record_time=0.2 s
 
 
 @pytest.fixture(scope="module")
-def run_dir(tmp_path_factory):
+def run_cache(tmp_path_factory):
+    """The run's own cache folder (the session's is shared with the other test worker, whose
+    entries would come and go under :func:`test_warm_rerun_uses_the_cache`)."""
+    return tmp_path_factory.mktemp("run-cache")
+
+
+@pytest.fixture(scope="module")
+def run_dir(tmp_path_factory, run_cache):
     out = tmp_path_factory.mktemp("run") / "out"
     r = subprocess.run([sys.executable, "-m", "geardyn", "run", "--out", str(out), *SHORT],
-                       capture_output=True, text=True, timeout=600)
+                       capture_output=True, text=True, timeout=600,
+                       env={**os.environ, "GEARDYN_CACHE_DIR": str(run_cache)})
     assert r.returncode == 0, r.stderr + r.stdout
     return out, r
 
@@ -409,15 +417,16 @@ def test_a_users_own_case_is_not_compared_with_the_paper(own_case_dir):
         assert "paper_table2" not in root.data_vars and "table2" in root.data_vars
 
 
-def test_warm_rerun_uses_the_cache(run_dir, tmp_path):
+def test_warm_rerun_uses_the_cache(run_dir, run_cache, tmp_path):
     """A second run of the same inputs reads the maps and records from the cache: it adds no
     cache entry (a record of what was built, not a wall-clock ratio)."""
     out, _ = run_dir
-    cache = Path(os.environ["GEARDYN_CACHE_DIR"])
+    cache = Path(run_cache)
     before = sorted(p.relative_to(cache) for p in cache.rglob("*.nc"))
     out2 = tmp_path / "again"
     r = subprocess.run([sys.executable, "-m", "geardyn", "run", "--out", str(out2), *SHORT],
-                       capture_output=True, text=True, timeout=600)
+                       capture_output=True, text=True, timeout=600,
+                       env={**os.environ, "GEARDYN_CACHE_DIR": str(cache)})
     assert r.returncode == 0, r.stderr + r.stdout
     after = sorted(p.relative_to(cache) for p in cache.rglob("*.nc"))
     assert before and after == before
@@ -454,11 +463,14 @@ def test_report_renders_in_a_real_browser(run_dir, tmp_path):
     assert dark[:400].any()  # the title at the top
 
 
-def test_progress_one_bar_per_stage_with_its_own_count(run_dir, tmp_path):
+def test_progress_one_bar_per_stage_with_its_own_count(run_dir, run_cache, tmp_path,
+                                                      monkeypatch):
     """The library's progress calls: stage announcements in order, then for every bar a count
     that runs from 0 to its own total without jumps to another bar's count (issue 13)."""
     from geardyn.config import paper_case
     from geardyn.studies.paper import STAGES, run_paper_study
+
+    monkeypatch.setenv("GEARDYN_CACHE_DIR", str(run_cache))  # run_dir's maps and records
 
     calls = []
     sets = [a for a in SHORT[SHORT.index("--set"):] if a != "--set"]

@@ -157,7 +157,9 @@ def crack_growth(
                            "numerical residue).")] = False,
     quick: Annotated[bool, typer.Option(
         "--quick", help="A coarse, fast run: module/4 steps, at most 20, 3 simulated lengths, "
-                        "0.2 s settle and 0.3 s record.")] = False,
+                        "0.2 s settle and 0.3 s record, and the stiffness maps of 'geardyn run "
+                        "--quick' (FE mesh refinement 0.5, at most 11 centre distances).")
+                        ] = False,
     stiffness: Annotated[str, typer.Option(
         "--stiffness", help="Mesh stiffness of the simulated lengths: 'pem' (the equivalent "
                             "straight crack, fast) or 'fe' (the grown path itself meshed, one FE "
@@ -229,6 +231,12 @@ def crack_growth(
     from ..io import atomic_path, write_netcdf_atomic, write_text_atomic
     from ..studies.crack_growth import crack_growth_study
     from ..studies.crack_growth_figures import FIGURES
+
+    if quick:  # the simulated lengths' maps as coarse as geardyn run --quick's (the growth and
+        # its SIFs have their own crack mesh: unchanged)
+        from ..studies.paper import quick_map_case
+
+        case = quick_map_case(case.with_overrides({"stiffness.method": stiffness}))
 
     with progress_bar() as bar, warnings.catch_warnings():
         warnings.simplefilter("ignore", UserWarning)  # map validity notes: in the map attrs

@@ -259,6 +259,9 @@ def add_indicators(case, growth, *, points: int = 5, settle_time: float | None =
                              "not used: the indicators use the FE map of the grown path itself "
                              "(equivalent_depth and equivalent_angle describe its chord only)"),
         "indicator_stiffness": stiffness,
+        "indicator_map_centre_distances": int(base.stiffness.centre_distances),
+        **({"indicator_fe_mesh_refinement": float(base.stiffness.fe.refinement)}
+           if stiffness == "fe" else {}),
         "indicator_model": sim.model,
         "indicator_settle_time_s": float(sim.settle_time),
         "indicator_record_time_s": float(sim.record_time),

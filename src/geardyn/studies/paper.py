@@ -264,8 +264,13 @@ QUICK_CENTRE_DISTANCES = 11
 
 def _map_case(case: Case, quick: bool) -> Case:
     """The case the stiffness maps are built from (coarser with ``--quick``)."""
-    if not quick:
-        return case
+    return quick_map_case(case) if quick else case
+
+
+def quick_map_case(case: Case) -> Case:
+    """The case whose stiffness maps a ``--quick`` run builds (``geardyn run``, ``geardyn
+    crack-growth``): the FE mesh refinement at most :data:`QUICK_REFINEMENT` and at most
+    :data:`QUICK_CENTRE_DISTANCES` centre distances; ``case`` itself where it is that coarse."""
     st = case.stiffness
     ov = {}
     if st.method == "fe" and st.fe.refinement > QUICK_REFINEMENT:
