@@ -293,6 +293,33 @@ def test_tooth_crack_runs_through_the_tooth(tooth_paths):
 
 
 @pytest.mark.slow
+def test_backup_ratio_one_still_breaks_the_tooth():
+    """Lewicki & Ballarini's second solid case: backup ratio 1.0 (the paper's pinion with its
+    bore raised to leave a rim one tooth height thick) also gives a tooth fracture in their
+    predictions and tests (abstract of NASA TM-107229). Their thin rims (0.5: rim or tooth,
+    0.3: rim) are not checked: a rim thinner than a module (6 mm here) is outside the model
+    (``crack_segment`` refuses a crack within one module of the bore; the sector is clamped on
+    the bore, which a thin rim on a web is not)."""
+    import geardyn
+    from geardyn.faults.tooth_growth import grow_tooth_crack, hpstc_roll
+    from geardyn.stiffness.fe.mesh import CrackGeometry
+
+    g0 = geardyn.paper_case().gear_pair().pinion
+    height = g0.tip_radius - g0.root_radius
+    bore = g0.root_radius - 1.0 * height
+    pair = geardyn.paper_case([f"pinion.bore_radius={bore}", f"gear.bore_radius={bore}"]
+                              ).gear_pair()
+    g = pair.pinion
+    path = grow_tooth_crack(g, STEEL, CrackGeometry(0.5e-3, math.radians(45)), load=100e3,
+                            load_roll=hpstc_roll(pair), step=1e-3, n_steps=60)
+    assert "outline" in path.stop
+    mouth, end = path.points[0], path.points[-1]
+    assert end[0] > 0  # across the tooth centreline
+    assert np.hypot(*(end - mouth * [-1.0, 1.0])) < 0.25 * 2 * abs(mouth[0])  # opposite fillet
+    assert np.hypot(*path.points.T).min() > g.root_radius - 0.25 * height  # not into the rim
+
+
+@pytest.mark.slow
 def test_tooth_crack_path_converges_with_the_step(tooth_paths):
     """Halving the growth step moves the path by less than a quarter of the coarse step."""
     _, paths = tooth_paths

@@ -38,8 +38,12 @@ Published path (qualitative comparison). Lewicki & Ballarini (NASA TM-107229 / A
 of 3.3 and 1.0 produced tooth fractures while a backup ratio of 0.3 produced rim fractures"
 (backup ratio = rim thickness / tooth height), in FE predictions (FRANC, quarter-point
 elements, automated remeshing) and in tests. Their path coordinates could not be read from this
-workplace, so the comparison is the failure mode only: a solid gear (backup ratio > 1) must
-grow its root crack through the tooth, not down into the rim.
+workplace, so the comparison is the failure mode only: the paper's pinion (backup ratio ~3)
+and the same pinion with a rim one tooth height thick (backup ratio 1.0) must grow the root
+crack through the tooth, not down into the rim (``tests/faults/test_sif.py``). Thinner rims
+(0.5, 0.3) are outside this model: a rim thinner than a module is refused by
+:func:`geardyn.stiffness.fe.mesh.crack_segment`, and the sector is clamped on the bore, which a
+thin rim on a web is not.
 """
 
 from __future__ import annotations
