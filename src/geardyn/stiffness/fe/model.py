@@ -282,6 +282,7 @@ def body_influence(gear: Gear, material: ElasticMaterial, settings: FESettings,
         mesh = build_body_mesh(gear, settings.mesh_settings(), crack, cut_radius=cut_radius)
         t_mesh = time.perf_counter() - t0
         body = ElasticBody(mesh, material)
+        body.factor(release_matrix=True)  # only solved from here: K is not kept (memory)
         u = load_roll_lengths(gear, settings.n_points)
         loads = (0,) if crack is None and cut_radius is None else mesh.offsets
         by = None if cut_radius is None else \
