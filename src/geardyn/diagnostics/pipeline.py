@@ -541,6 +541,7 @@ def diagnose(
     pwvd_max_order: float | None = None,
     units: Mapping[str, str] | None = None,
     source: str = "",
+    pwvd_distributions: bool = True,
 ) -> DiagnosisResult:
     """Run the diagnostics chain on one or more signals sharing a shaft angle.
 
@@ -579,6 +580,11 @@ def diagnose(
         Unit of each signal for labels.
     source : str
         Description of the input (file name) for the report.
+    pwvd_distributions : bool
+        Compute the PWVD distributions (default). False leaves each PWVD's distribution empty,
+        shape (0, 0), with its axes and settings (:func:`.tfd.pwvd` ``distribution``); every
+        other result is the same. For a caller that draws no PWVD: the two PWVDs per signal are
+        most of this function's time.
 
     Returns
     -------
@@ -643,8 +649,10 @@ def diagnose(
             regular=regular(avg, teeth=z),
             difference=difference(avg, teeth=z),
             demodulation=dem,
-            pwvd_tsa=pwvd(avg, window_length=pwvd_window_length, max_order=max_order),
-            pwvd_residual=pwvd(res, window_length=pwvd_window_length, max_order=max_order),
+            pwvd_tsa=pwvd(avg, window_length=pwvd_window_length, max_order=max_order,
+                          distribution=pwvd_distributions),
+            pwvd_residual=pwvd(res, window_length=pwvd_window_length, max_order=max_order,
+                               distribution=pwvd_distributions),
             statistics=signal_statistics(avg),
             residual_kurtosis=kurtosis(res, warn_constant=False),
             envelope_kurtosis=kurtosis(dem.envelope, warn_constant=False),

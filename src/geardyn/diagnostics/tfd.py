@@ -150,7 +150,7 @@ def pwvd(x, *, samples_per_rev: int | None = None, window_length: int | None = N
          window="hamming", n_fbins: int | None = None, periodic: bool = True,
          analytic: bool = True, remove_mean: bool = True,
          time_window_length: int | None = None, time_window="hamming",
-         max_order: float | None = None) -> PWVDResult:
+         max_order: float | None = None, distribution: bool = True) -> PWVDResult:
     """Pseudo Wigner-Ville distribution (optionally smoothed) of a TSA.
 
     See the module docstring for the definition; bin k is order ``k * N / (2 * n_fbins)``, i.e.
@@ -185,6 +185,11 @@ def pwvd(x, *, samples_per_rev: int | None = None, window_length: int | None = N
         Smoothing window g (normalised to unit sum).
     max_order : float, optional
         Keep only the order bins up to this order [-] (saves memory); default all.
+    distribution : bool
+        Compute the distribution (default). False returns the same axes and settings with an
+        empty (0, 0) distribution, after the same checks of the input and options: for a caller
+        that keeps the other results of :func:`geardyn.diagnostics.diagnose` but draws no PWVD
+        (most of ``diagnose``'s time is the two PWVDs per signal).
 
     Returns
     -------
@@ -228,13 +233,18 @@ def pwvd(x, *, samples_per_rev: int | None = None, window_length: int | None = N
         ok = (ip < n) & (im >= 0)
         return np.where(ok, z[np.minimum(ip, n - 1)] * np.conj(z[np.maximum(im, 0)]), 0.0)
 
-    def distribution(r: np.ndarray) -> np.ndarray:
+    def rows_of(r: np.ndarray) -> np.ndarray:
         """Rows of the distribution from their windowed lag products (FFT over the lag)."""
         buf = np.zeros((r.shape[0], nf), dtype=np.complex128)
         buf[:, : lag + 1] = r
         spec = sfft.fft(buf, axis=1, overwrite_x=True)
         return (2.0 * spec.real - r[:, :1].real)[:, keep]
 
+    if not distribution:
+        return PWVDResult(distribution=np.zeros((0, 0)), angle=2.0 * np.pi * np.arange(n) / nrev,
+                          orders=orders[keep], window_length=int(h.size),
+                          time_window_length=int(twl), periodic=bool(periodic),
+                          n_fbins=int(nf))
     dist = np.empty((n, int(np.count_nonzero(keep))))
     if twl > 1:  # angle smoothing couples the rows: all lag products at once
         g = _odd_window(time_window, twl, "time_window")
@@ -244,12 +254,12 @@ def pwvd(x, *, samples_per_rev: int | None = None, window_length: int | None = N
         r = _smooth_rows(lag_products(rows), g, periodic, valid)
         r *= h[lag:][None, :]
         for b0 in range(0, n, _PWVD_ROWS):
-            dist[b0:b0 + _PWVD_ROWS] = distribution(r[b0:b0 + _PWVD_ROWS])
+            dist[b0:b0 + _PWVD_ROWS] = rows_of(r[b0:b0 + _PWVD_ROWS])
     else:  # a block of angles at a time: the n x n_fbins spectrum is never held whole
         for b0 in range(0, n, _PWVD_ROWS):
             r = lag_products(np.arange(b0, min(b0 + _PWVD_ROWS, n)))
             r *= h[lag:][None, :]
-            dist[b0:b0 + _PWVD_ROWS] = distribution(r)
+            dist[b0:b0 + _PWVD_ROWS] = rows_of(r)
     orders = orders[keep]
     return PWVDResult(distribution=dist, angle=2.0 * np.pi * np.arange(n) / nrev, orders=orders,
                       window_length=int(h.size), time_window_length=int(twl),

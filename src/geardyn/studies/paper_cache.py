@@ -35,6 +35,7 @@ import numpy as np
 from .paper_result import _digest, _source_digest
 
 __all__ = ["fingerprint", "cached_diagnosis", "write_output", "without_distributions",
+           "save_dataset", "load_dataset",
            "DIAGNOSIS_CACHE_VERSION", "OUTPUT_CACHE_VERSION"]
 
 #: Bump when a cached diagnosis changes meaning or layout, so cached ones are recomputed.
@@ -99,8 +100,10 @@ def cached_diagnosis(inputs: dict, key: str | None = None, cache=None):
     Returns
     -------
     (DiagnosisResult, DiagnosisResult or None)
-        The result without distributions, and the full result when it was computed here (None
-        when it came from the cache).
+        The result without distributions, and the same result when it was computed here (None
+        when it came from the cache). The distributions are not computed at all
+        (``diagnose(..., pwvd_distributions=False)``, equal to dropping them afterwards; the
+        figures compute the two they draw).
     """
     from ..cache import default_cache
     from ..diagnostics import diagnose
@@ -110,8 +113,8 @@ def cached_diagnosis(inputs: dict, key: str | None = None, cache=None):
     full: list = []
 
     def build():
-        full.append(diagnose(**inputs))
-        return without_distributions(full[0])
+        full.append(diagnose(**inputs, pwvd_distributions=False))
+        return full[0]
 
     diag, _ = cache.get_or_build("diagnosis", key, ".npz", build, save_tree, load_tree)
     return diag, (full[0] if full else None)
@@ -192,6 +195,41 @@ def load_tree(path: Path):
         arrays = {name: z[name] for name in z.files}
     tree = json.loads(arrays.pop("__tree__").tobytes().decode("utf-8"))
     return _decode(tree, arrays)
+
+
+def save_dataset(ds, path: Path) -> None:
+    """An xarray Dataset of plain variables (numeric arrays with their dims and attrs, as a
+    simulation record is) to ``.npz`` through :func:`save_tree`: every array and the type of
+    every attribute as they were (a NetCDF round trip turns Python ints and floats into NumPy
+    scalars), in the variables' order, without compression. The simulation cache uses it: a
+    compressed NetCDF-4 write cost 0.13-0.28 s per record (h5netcdf creates each variable with
+    its filters and dimension scales), the ``.npz`` about 0.02 s (issue 16)."""
+    tree = {"attrs": dict(ds.attrs), "coords": list(ds.coords),
+            "variables": {name: {"dims": list(v.dims), "data": np.asarray(v.values),
+                                 "attrs": dict(v.attrs)}
+                          for name, v in ds.variables.items()}}
+    save_tree(tree, path)
+
+
+def load_dataset(path: Path, required: tuple[str, ...] = ()):
+    """Read what :func:`save_dataset` wrote; ``required`` variables must be there
+    (:class:`geardyn.errors.DataFileError` otherwise, which the cache treats as a damaged entry
+    and rebuilds)."""
+    import xarray as xr
+
+    from ..errors import DataFileError
+
+    tree = load_tree(path)
+    if not isinstance(tree, dict) or set(tree) != {"attrs", "coords", "variables"}:
+        raise DataFileError(path, "is not a stored dataset")
+    variables = {name: xr.Variable(tuple(v["dims"]), v["data"], v["attrs"])
+                 for name, v in tree["variables"].items()}
+    ds = xr.Dataset(variables, attrs=tree["attrs"]).set_coords(
+        [c for c in tree["coords"] if c in variables])
+    missing = [v for v in required if v not in ds.variables]
+    if missing:
+        raise DataFileError(path, f"lacks the variable(s) {', '.join(missing)}")
+    return ds
 
 
 # --------------------------------------------------------------------------------------------
