@@ -195,12 +195,37 @@ def direct_setup(paper_case):
     return sec, tan, body, s
 
 
+#: Direct-contact operators by (fixture, pinion angle): one per position serves every torque
+#: (the Delassus matrix is the costly part and does not depend on the load)
+_OPERATORS: dict = {}
+
+
 def _direct(setup, theta, torque):
-    from geardyn.stiffness.fe.direct import direct_contact
+    from geardyn.stiffness.fe.direct import direct_operator
 
     sec, _, body, _ = setup
     m = sec[100.0]
-    return direct_contact(body, body, m.pair, theta, 0.5e-3, torque / m.face_width, reach=25e-6)
+    key = (id(setup), theta)
+    if key not in _OPERATORS:
+        _OPERATORS[key] = direct_operator(body, body, m.pair, theta, 0.5e-3, reach=25e-6)
+    return _OPERATORS[key].solve(torque / m.face_width)
+
+
+@pytest.mark.slow
+def test_one_operator_serves_every_torque(direct_setup):
+    """``direct_contact`` (operator built for the call) and a reused operator's ``solve`` give
+    the same contact, bit for bit, at two torques."""
+    from geardyn.stiffness.fe.direct import direct_contact
+
+    sec, _, body, _ = direct_setup
+    m = sec[100.0]
+    th = 0.5 * m.pair.mesh_angle
+    for t in (60.0, 140.0):
+        a = direct_contact(body, body, m.pair, th, 0.5e-3, t / m.face_width, reach=25e-6)
+        b = _direct(direct_setup, th, t)
+        assert a.rotation == b.rotation and a.pair_force == b.pair_force and a.rotation > 0
+        np.testing.assert_array_equal(a.node_force, b.node_force)
+        np.testing.assert_array_equal(a.node_compliance, b.node_compliance)
 
 
 @pytest.mark.slow

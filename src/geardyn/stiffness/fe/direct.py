@@ -43,7 +43,7 @@ from scipy.optimize import brentq, nnls
 from ...errors import NumericalError
 from .solve import ElasticBody
 
-__all__ = ["DirectResult", "direct_contact"]
+__all__ = ["DirectOperator", "DirectResult", "direct_contact", "direct_operator"]
 
 
 @dataclass(frozen=True)
@@ -98,6 +98,80 @@ def _rot(a: float) -> np.ndarray:
     return np.array([[c, -s], [s, c]])
 
 
+@dataclass(frozen=True)
+class DirectOperator:
+    """The contact problem of :func:`direct_operator` at one position, ready for any torque.
+
+    Attributes
+    ----------
+    gap : ndarray, shape (n,)
+        Unloaded gap of each candidate node [m].
+    arm : ndarray, shape (n,)
+        Lever arm of each candidate's normal about the pinion centre [m]: a pinion rotation
+        ``dth`` closes the gap by ``arm * dth``.
+    pair_of : ndarray of int, shape (n,)
+        Pair index of each candidate (as :attr:`DirectResult.node_pair`).
+    node_kind : ndarray of str, shape (n,)
+        ``"p"`` pinion flank node or ``"g"`` gear tip corner.
+    W : ndarray, shape (n, n)
+        Delassus matrix (symmetrised) [m/(N/m)].
+    L : ndarray, shape (n, n)
+        Its Cholesky factor (with a 1e-14 relative diagonal shift).
+    reach : float
+        Candidate reach the operator was built with [m].
+    seconds : float
+        Wall time of building it [s].
+    """
+
+    gap: np.ndarray
+    arm: np.ndarray
+    pair_of: np.ndarray
+    node_kind: np.ndarray
+    W: np.ndarray
+    L: np.ndarray
+    reach: float
+    seconds: float
+
+    def solve(self, torque_per_width: float) -> DirectResult:
+        """The loaded contact under ``torque_per_width`` [N m/m]: non-negative multipliers
+        (NNLS on the Cholesky factor) and the pinion rotation from the torque balance.
+        ``seconds`` of the result is this operator's build time plus this solve's."""
+        t0 = time.perf_counter()
+        gap, arm, L, reach = self.gap, self.arm, self.L, self.reach
+        n = gap.size
+
+        def forces(dth: float) -> np.ndarray:
+            c = gap - dth * arm
+            rhs = -np.linalg.solve(L, c)
+            lam, _ = nnls(L.T, rhs, maxiter=50 * n)
+            return lam
+
+        def resid(dth: float) -> float:
+            return float(arm @ forces(dth)) - torque_per_width
+
+        lo = 0.0
+        hi = 1e-6
+        while resid(hi) < 0:
+            hi *= 2
+            if hi > 1:
+                raise NumericalError("direct contact: no rotation balances the torque")
+        dth = brentq(resid, lo, hi, xtol=1e-16, rtol=1e-12)
+        lam = forces(dth)
+        if np.any(gap[lam > 0] > 0.5 * reach):
+            raise NumericalError("direct contact: loaded nodes near the candidate reach; "
+                                 "increase reach", state={"reach": reach, "max_loaded_gap":
+                                                          float(gap[lam > 0].max())})
+        pf: dict[int, float] = {}
+        for q, f in zip(self.pair_of, lam, strict=True):
+            if f > 0:
+                pf[int(q)] = pf.get(int(q), 0.0) + float(f)
+        return DirectResult(rotation=float(dth), pair_force=pf,
+                            n_contact_nodes=int(np.sum(lam > 0)), n_candidates=n,
+                            seconds=self.seconds + time.perf_counter() - t0,
+                            node_pair=self.pair_of, node_kind=self.node_kind, node_gap=gap,
+                            node_force=lam, node_compliance=np.diag(self.W).copy())
+
+
 def _surface(body: ElasticBody, names: list[str]):
     """Segments (v0, v1, facet) of named boundary curves."""
     segs = [body.mesh.edges[n] for n in names if n in body.mesh.edges]
@@ -142,6 +216,9 @@ def direct_contact(pinion: ElasticBody, gear: ElasticBody, pair, theta: float, d
                    torque_per_width: float, *, reach: float = 25e-6) -> DirectResult:
     """Solve the loaded contact of the two FE bodies at ``(theta, dd)``.
 
+    ``direct_operator(pinion, gear, pair, theta, dd, reach=reach).solve(torque_per_width)``:
+    at several torques, build the operator once (:func:`direct_operator`).
+
     Parameters
     ----------
     pinion, gear : ElasticBody
@@ -161,6 +238,34 @@ def direct_contact(pinion: ElasticBody, gear: ElasticBody, pair, theta: float, d
     Returns
     -------
     DirectResult
+    """
+    return direct_operator(pinion, gear, pair, theta, dd, reach=reach).solve(torque_per_width)
+
+
+def direct_operator(pinion: ElasticBody, gear: ElasticBody, pair, theta: float, dd: float,
+                    *, reach: float = 25e-6) -> DirectOperator:
+    """The contact problem of the two FE bodies at ``(theta, dd)``, for any torque: candidates,
+    unloaded gaps, lever arms and the Delassus matrix with its Cholesky factor. Everything here
+    is the unloaded geometry and the bodies' compliance; the torque enters only in
+    :meth:`DirectOperator.solve` (linearised contact), so one operator serves every torque.
+
+    Parameters
+    ----------
+    pinion, gear : ElasticBody
+        Bodies in their body frames (:mod:`.mesh` conventions); body tooth 0 of the pinion is
+        pinion tooth 0 and body tooth 0 of the gear is gear tooth 0 (pair 0). Their refined teeth
+        must include every tooth in contact.
+    pair : geardyn.geometry.GearPair
+    theta : float
+        Pinion angle [rad] (backlash closed).
+    dd : float
+        Centre distance change [m].
+    reach : float
+        Slave nodes with an unloaded gap below ``reach`` are candidates [m].
+
+    Returns
+    -------
+    DirectOperator
     """
     t0 = time.perf_counter()
     p1, p2 = pair.pinion, pair.gear
@@ -269,35 +374,7 @@ def direct_contact(pinion: ElasticBody, gear: ElasticBody, pair, theta: float, d
     W = G1 @ pinion.solve(G1.T.toarray()) + G2 @ gear.solve(G2.T.toarray())
     W = 0.5 * (W + W.T)
     L = np.linalg.cholesky(W + 1e-14 * np.trace(W) / n * np.eye(n))
-
-    def forces(dth: float) -> np.ndarray:
-        c = gap - dth * arm
-        rhs = -np.linalg.solve(L, c)
-        lam, _ = nnls(L.T, rhs, maxiter=50 * n)
-        return lam
-
-    def resid(dth: float) -> float:
-        return float(arm @ forces(dth)) - torque_per_width
-
-    lo = 0.0
-    hi = 1e-6
-    while resid(hi) < 0:
-        hi *= 2
-        if hi > 1:
-            raise NumericalError("direct contact: no rotation balances the torque")
-    dth = brentq(resid, lo, hi, xtol=1e-16, rtol=1e-12)
-    lam = forces(dth)
-    if np.any(gap[lam > 0] > 0.5 * reach):
-        raise NumericalError("direct contact: loaded nodes near the candidate reach; increase "
-                             "reach", state={"reach": reach, "max_loaded_gap":
-                                             float(gap[lam > 0].max())})
-    pf: dict[int, float] = {}
-    for q, f in zip(pair_of, lam, strict=True):
-        if f > 0:
-            pf[int(q)] = pf.get(int(q), 0.0) + float(f)
-    return DirectResult(rotation=float(dth), pair_force=pf,
-                        n_contact_nodes=int(np.sum(lam > 0)), n_candidates=n,
-                        seconds=time.perf_counter() - t0, node_pair=pair_of,
-                        node_kind=np.array([r[0] for r in rows1 + rows2]), node_gap=gap,
-                        node_force=lam, node_compliance=np.diag(W).copy())
+    return DirectOperator(gap=gap, arm=arm, pair_of=pair_of,
+                          node_kind=np.array([r[0] for r in rows1 + rows2]), W=W, L=L,
+                          reach=float(reach), seconds=time.perf_counter() - t0)
 
