@@ -110,14 +110,10 @@ def cached_diagnosis(inputs: dict, key: str | None = None, cache=None):
 
     cache = cache or default_cache()
     key = key or diagnosis_key(inputs)
-    full: list = []
-
-    def build():
-        full.append(diagnose(**inputs, pwvd_distributions=False))
-        return full[0]
-
-    diag, _ = cache.get_or_build("diagnosis", key, ".npz", build, save_tree, load_tree)
-    return diag, (full[0] if full else None)
+    diag, hit = cache.get_or_build(
+        "diagnosis", key, ".npz", lambda: diagnose(**inputs, pwvd_distributions=False),
+        save_tree, load_tree)
+    return diag, (None if hit else diag)
 
 
 #: Modules whose dataclasses a stored tree may name (:func:`load_tree` refuses others).

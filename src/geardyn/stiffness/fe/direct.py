@@ -221,19 +221,10 @@ def direct_contact(pinion: ElasticBody, gear: ElasticBody, pair, theta: float, d
 
     Parameters
     ----------
-    pinion, gear : ElasticBody
-        Bodies in their body frames (:mod:`.mesh` conventions); body tooth 0 of the pinion is
-        pinion tooth 0 and body tooth 0 of the gear is gear tooth 0 (pair 0). Their refined teeth
-        must include every tooth in contact.
-    pair : geardyn.geometry.GearPair
-    theta : float
-        Pinion angle [rad] (backlash closed).
-    dd : float
-        Centre distance change [m].
+    pinion, gear, pair, theta, dd, reach
+        As in :func:`direct_operator`.
     torque_per_width : float
         Pinion torque per metre of face width [N m/m].
-    reach : float
-        Slave nodes with an unloaded gap below ``reach`` are candidates [m].
 
     Returns
     -------
