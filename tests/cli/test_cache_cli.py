@@ -16,14 +16,16 @@ from geardyn.cache import Cache
 from geardyn.cache_admin import cache_usage, parse_age, prune
 from geardyn.errors import InputError
 
+from .._cli_fork import run_geardyn
+
 GEARDYN = [sys.executable, "-m", "geardyn"]
 DAY = 86400.0
 
 
 def _cli(*args, cache: Path):
     env = {**os.environ, "GEARDYN_CACHE_DIR": str(cache)}
-    return subprocess.run(GEARDYN + list(args), capture_output=True, text=True, env=env,
-                          timeout=120, stdin=subprocess.DEVNULL)
+    return run_geardyn(list(args), capture_output=True, text=True, env=env,
+                       timeout=120, stdin=subprocess.DEVNULL)
 
 
 def _fill(root: Path, now: float) -> Cache:

@@ -3,17 +3,18 @@
 from __future__ import annotations
 
 import json
-import subprocess
 import sys
 
 import pytest
+
+from .._cli_fork import run_geardyn
 
 GEARDYN = [sys.executable, "-m", "geardyn"]
 
 
 def run(*args, cwd=None, timeout=120):
-    return subprocess.run(GEARDYN + list(args), capture_output=True, text=True, cwd=cwd,
-                          timeout=timeout)
+    return run_geardyn(list(args), capture_output=True, text=True, cwd=cwd,
+                       timeout=timeout)
 
 
 def test_help_lists_commands():

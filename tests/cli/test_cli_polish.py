@@ -15,14 +15,16 @@ import pytest
 
 import geardyn
 
+from .._cli_fork import run_geardyn
+
 GEARDYN = [sys.executable, "-m", "geardyn"]
 COMMANDS = [["run"], ["geometry"], ["stiffness"], ["simulate"], ["diagnose"], ["sweep"],
             ["config"], ["config", "show"], ["config", "validate"], ["config", "schema"]]
 
 
 def run(*args, env=None, **kw):
-    return subprocess.run(GEARDYN + list(args), capture_output=True, text=True, timeout=300,
-                          env={**os.environ, "COLUMNS": "80", **(env or {})}, **kw)
+    return run_geardyn(list(args), capture_output=True, text=True, timeout=300,
+                       env={**os.environ, "COLUMNS": "80", **(env or {})}, **kw)
 
 
 @pytest.mark.parametrize("flag", ["--version", "-V"])

@@ -3,11 +3,11 @@
 from __future__ import annotations
 
 import json
-import subprocess
-import sys
 
 import numpy as np
 import pytest
+
+from .._cli_fork import run_geardyn
 
 
 def _write_csv(path):
@@ -24,9 +24,9 @@ def test_diagnose_measured_csv(tmp_path):
     csv = tmp_path / "m.csv"
     _write_csv(csv)
     out = tmp_path / "out"
-    r = subprocess.run([sys.executable, "-m", "geardyn", "diagnose", str(csv), "--time", "t",
-                        "--angle", "angle", "--signal", "acc", "--out", str(out)],
-                       capture_output=True, text=True, timeout=300)
+    r = run_geardyn(["diagnose", str(csv), "--time", "t",
+                     "--angle", "angle", "--signal", "acc", "--out", str(out)],
+                    capture_output=True, text=True, timeout=300)
     assert r.returncode == 0, r.stderr
     m = json.loads((out / "metrics.json").read_text())
     sig = m["signals"]["acc"]
@@ -45,7 +45,7 @@ def test_diagnose_measured_csv(tmp_path):
 def test_diagnose_bad_input(tmp_path, args, words):
     csv = tmp_path / "m.csv"
     _write_csv(csv)
-    r = subprocess.run([sys.executable, "-m", "geardyn", "diagnose", str(csv), *args, "--out",
-                        str(tmp_path / "o")], capture_output=True, text=True, timeout=300)
+    r = run_geardyn(["diagnose", str(csv), *args, "--out",
+                     str(tmp_path / "o")], capture_output=True, text=True, timeout=300)
     assert r.returncode == 2
     assert words in r.stderr and "Traceback" not in r.stderr

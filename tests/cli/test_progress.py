@@ -6,14 +6,14 @@ from __future__ import annotations
 import io
 import os
 import re
-import subprocess
-import sys
 
 import pytest
 from rich.console import Console
 
 from geardyn.cli import _common
 from geardyn.cli._common import StageProgress, progress_bar
+
+from .._cli_fork import run_geardyn
 
 ANSI = re.compile(r"\x1b\[[0-9;?]*[A-Za-z]")
 
@@ -102,10 +102,10 @@ def test_rendered_bars_fit_80_columns(monkeypatch):
 def test_stiffness_progress_through_the_cli(tmp_path):
     env = {**os.environ, "GEARDYN_PROGRESS": "1", "COLUMNS": "80",
            "GEARDYN_CACHE_DIR": str(tmp_path / "c")}
-    r = subprocess.run([sys.executable, "-m", "geardyn", "stiffness", "--method", "pem", "--out",
-                        str(tmp_path / "k"), "--set", "stiffness.centre_distances=6", "--set",
-                        "stiffness.nodes_per_segment=8"], env=env, capture_output=True,
-                       text=True, timeout=300)
+    r = run_geardyn(["stiffness", "--method", "pem", "--out",
+                     str(tmp_path / "k"), "--set", "stiffness.centre_distances=6", "--set",
+                     "stiffness.nodes_per_segment=8"], env=env, capture_output=True,
+                    text=True, timeout=300)
     assert r.returncode == 0, r.stderr
     lines = _lines(r.stderr)
     assert all(len(ln) <= 80 for ln in lines), [ln for ln in lines if len(ln) > 80]

@@ -11,11 +11,12 @@ from __future__ import annotations
 import json
 import os
 import re
-import subprocess
 import sys
 
 import numpy as np
 import pytest
+
+from .._cli_fork import run_geardyn
 
 GEARDYN = [sys.executable, "-m", "geardyn"]
 SMALL = ["--set", "stiffness.centre_distances=6", "--set", "stiffness.nodes_per_segment=8"]
@@ -28,8 +29,8 @@ RUN = ["--quick", "--stiffness", "pem", "--set", "simulation.record_time=0.2 s",
 
 def run(*args, cache, cwd=None, **extra_env):
     env = {**os.environ, "GEARDYN_CACHE_DIR": str(cache), **extra_env}
-    return subprocess.run(GEARDYN + list(args), capture_output=True, text=True, env=env,
-                          cwd=cwd, timeout=1200)
+    return run_geardyn(list(args), capture_output=True, text=True, env=env,
+                       cwd=cwd, timeout=1200)
 
 
 def _one_error_line(r):

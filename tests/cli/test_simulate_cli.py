@@ -3,11 +3,12 @@
 from __future__ import annotations
 
 import os
-import subprocess
 import sys
 
 import pytest
 import xarray as xr
+
+from .._cli_fork import run_geardyn
 
 GEARDYN = [sys.executable, "-m", "geardyn"]
 SHORT = ["--set", "simulation.settle_time=0.002", "--set", "simulation.record_time=0.004",
@@ -17,8 +18,8 @@ SHORT = ["--set", "simulation.settle_time=0.002", "--set", "simulation.record_ti
 
 def run(*args, cache):
     env = {**os.environ, "GEARDYN_CACHE_DIR": str(cache)}
-    return subprocess.run(GEARDYN + list(args), capture_output=True, text=True, env=env,
-                          timeout=300)
+    return run_geardyn(list(args), capture_output=True, text=True, env=env,
+                       timeout=300)
 
 
 @pytest.mark.slow

@@ -3,11 +3,12 @@
 from __future__ import annotations
 
 import os
-import subprocess
 import sys
 
 import pytest
 import xarray as xr
+
+from .._cli_fork import run_geardyn
 
 GEARDYN = [sys.executable, "-m", "geardyn"]
 SMALL = ["--method", "pem", "--set", "stiffness.centre_distances=6",
@@ -16,8 +17,8 @@ SMALL = ["--method", "pem", "--set", "stiffness.centre_distances=6",
 
 def run(*args, cache):
     env = {**os.environ, "GEARDYN_CACHE_DIR": str(cache)}
-    return subprocess.run(GEARDYN + list(args), capture_output=True, text=True, env=env,
-                          timeout=300)
+    return run_geardyn(list(args), capture_output=True, text=True, env=env,
+                       timeout=300)
 
 
 @pytest.mark.slow

@@ -5,10 +5,11 @@ no traceback; the library refuses the same runs."""
 from __future__ import annotations
 
 import os
-import subprocess
 import sys
 
 import pytest
+
+from .._cli_fork import run_geardyn
 
 GEARDYN = [sys.executable, "-m", "geardyn"]
 PEM = ["--set", "stiffness.method=pem", "--set", "stiffness.centre_distances=6",
@@ -17,8 +18,8 @@ PEM = ["--set", "stiffness.method=pem", "--set", "stiffness.centre_distances=6",
 
 def run(*args, tmp_path, cwd=None):
     env = {**os.environ, "GEARDYN_CACHE_DIR": str(tmp_path / "cache")}
-    return subprocess.run(GEARDYN + list(args), capture_output=True, text=True, env=env,
-                          cwd=cwd, timeout=300)
+    return run_geardyn(list(args), capture_output=True, text=True, env=env,
+                       cwd=cwd, timeout=300)
 
 
 def _one_error_line(r):

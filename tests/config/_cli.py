@@ -3,11 +3,12 @@
 from __future__ import annotations
 
 import subprocess
-import sys
 
 from typer.testing import CliRunner
 
 from geardyn.cli import app
+
+from .._cli_fork import run_geardyn
 
 runner = CliRunner()
 
@@ -23,8 +24,8 @@ def cli(*args: str):
 
 def cli_proc(*args: str, cwd=None) -> subprocess.CompletedProcess:
     """Run ``python -m geardyn ARGS`` in a subprocess."""
-    return subprocess.run([sys.executable, "-m", "geardyn", *args], capture_output=True,
-                          text=True, timeout=HANG_GUARD, cwd=cwd)
+    return run_geardyn([*args], capture_output=True,
+                       text=True, timeout=HANG_GUARD, cwd=cwd)
 
 
 def assert_clean_error(result, *words: str) -> str:

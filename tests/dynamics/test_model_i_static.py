@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import math
 import os
-import subprocess
 import sys
 import textwrap
 import warnings
@@ -35,6 +34,7 @@ from geardyn.errors import InputError
 from geardyn.stiffness import StiffnessMap, centre_distance_grid
 from geardyn.studies.model_compare import compare_models
 
+from .._cli_fork import run_geardyn
 from ._support import geometric_map, short_case
 
 
@@ -278,8 +278,8 @@ SHORT = ["--set", "simulation.settle_time=0.002", "--set", "simulation.record_ti
 
 def _run(*args, cache):
     env = {**os.environ, "GEARDYN_CACHE_DIR": str(cache)}
-    return subprocess.run(GEARDYN + list(args), capture_output=True, text=True, env=env,
-                          timeout=300)
+    return run_geardyn(list(args), capture_output=True, text=True, env=env,
+                       timeout=300)
 
 
 @pytest.mark.slow

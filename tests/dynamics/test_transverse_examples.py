@@ -4,12 +4,12 @@ examples/transverse/case.toml and ``geardyn sweep`` over the coefficient of fric
 from __future__ import annotations
 
 import os
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+
+from .._cli_fork import run_geardyn
 
 ROOT = Path(__file__).resolve().parents[2]
 EXAMPLES = ROOT / "examples" / "transverse"
@@ -17,8 +17,8 @@ EXAMPLES = ROOT / "examples" / "transverse"
 
 def _run(args, tmp_path, timeout=600):
     env = {**os.environ, "GEARDYN_CACHE_DIR": str(tmp_path / "cache")}
-    return subprocess.run([sys.executable, "-m", "geardyn", *args], capture_output=True,
-                          text=True, env=env, timeout=timeout, cwd=tmp_path)
+    return run_geardyn([*args], capture_output=True,
+                       text=True, env=env, timeout=timeout, cwd=tmp_path)
 
 
 @pytest.mark.slow

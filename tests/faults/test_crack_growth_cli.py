@@ -12,14 +12,14 @@ from __future__ import annotations
 import json
 import math
 import os
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from geardyn.errors import InputError
+
+from .._cli_fork import run_geardyn
 
 ROOT = Path(__file__).resolve().parents[2]
 EXAMPLE = ROOT / "examples" / "faults" / "crack_growth.toml"
@@ -31,8 +31,8 @@ PARIS = ["--paris-c", "1.593e-11 m/cycle/(MPa m^0.5)^m", "--paris-m", "3.668"]
 def _run(args, tmp_path, timeout=600):
     env = {**os.environ, "GEARDYN_CACHE_DIR": str(tmp_path / "cache")}
     env.pop("GEARDYN_DEBUG", None)
-    return subprocess.run([sys.executable, "-m", "geardyn", "crack-growth", *args],
-                          capture_output=True, text=True, env=env, timeout=timeout, cwd=tmp_path)
+    return run_geardyn(["crack-growth", *args],
+                       capture_output=True, text=True, env=env, timeout=timeout, cwd=tmp_path)
 
 
 # ------------------------------------------------------------------------------ fast tier

@@ -4,12 +4,12 @@ file of examples/faults/ and ``geardyn sweep`` over a spall's width (examples ar
 from __future__ import annotations
 
 import os
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+
+from .._cli_fork import run_geardyn
 
 ROOT = Path(__file__).resolve().parents[2]
 EXAMPLES = ROOT / "examples" / "faults"
@@ -19,8 +19,8 @@ SMALL = ["--set", "stiffness.centre_distances=3", "--set", "stiffness.nodes_per_
 
 def _run(args, tmp_path, timeout=600):
     env = {**os.environ, "GEARDYN_CACHE_DIR": str(tmp_path / "cache")}
-    return subprocess.run([sys.executable, "-m", "geardyn", *args], capture_output=True,
-                          text=True, env=env, timeout=timeout, cwd=tmp_path)
+    return run_geardyn([*args], capture_output=True,
+                       text=True, env=env, timeout=timeout, cwd=tmp_path)
 
 
 def test_every_fault_type_has_an_example():

@@ -11,12 +11,12 @@ of the gear bearing's velocity (residual energy over regular-meshing energy) ris
 from __future__ import annotations
 
 import os
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+
+from .._cli_fork import run_geardyn
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "faults"
 
@@ -56,9 +56,9 @@ def test_fault_size_sweep_through_the_cli(tmp_path, base, axis, values):
     spec.write_text(SWEEP.format(name=base.split(".")[0], base=(EXAMPLES / base).as_posix(),
                                  axis=axis, values=values))
     store = tmp_path / "s.zarr"
-    r = subprocess.run([sys.executable, "-m", "geardyn", "sweep", str(spec), "--out", str(store),
-                        "--workers", "1"], capture_output=True, text=True, timeout=900,
-                       cwd=tmp_path, env={**os.environ, "GEARDYN_PROGRESS": "0"})
+    r = run_geardyn(["sweep", str(spec), "--out", str(store),
+                     "--workers", "1"], capture_output=True, text=True, timeout=900,
+                    cwd=tmp_path, env={**os.environ, "GEARDYN_PROGRESS": "0"})
     assert r.returncode == 0, r.stdout + r.stderr
     ds = open_sweep(store).load()
     assert np.all(ds.status.values == 1), ds.error.values

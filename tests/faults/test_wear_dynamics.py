@@ -27,6 +27,8 @@ from geardyn.modifications import ToothModifications
 from geardyn.static_te import static_transmission_error
 from geardyn.stiffness import build_map
 
+from .._cli_fork import run_geardyn
+
 WEAR = Path(__file__).resolve().parents[2] / "examples" / "faults" / "wear.toml"
 DELTA = 5e-6
 
@@ -86,9 +88,6 @@ def test_the_healthy_runs_of_a_study_carry_no_wear(healthy_map, tmp_path):
     """A study's healthy pair has no faults: ``without_faults`` removes the wear gap from the
     tooth deviations (the maps leave faults out with ``cracked=False``); the faulty runs keep
     it. Checked on ``geardyn simulate --no-crack`` and the ``geardyn run`` pipeline's cases."""
-    import subprocess
-    import sys
-
     import xarray as xr
 
     from geardyn.faults import without_faults
@@ -99,14 +98,13 @@ def test_the_healthy_runs_of_a_study_carry_no_wear(healthy_map, tmp_path):
     assert not ToothModifications.from_case(healthy).active and healthy.faults == []
     plain = load_case(WEAR.parent.parent.parent / "src" / "geardyn" / "cases" / "xue_howard.toml")
     assert without_faults(plain) is plain  # no faults: the same case, the same cache keys
-    args = [sys.executable, "-m", "geardyn", "simulate", "--config", str(WEAR), "--set",
+    args = ["simulate", "--config", str(WEAR), "--set",
             "faults.0.stiffness=false", "--set", f"faults.0.depth={DELTA}", "--set",
             "stiffness.centre_distances=3", "--set", "simulation.settle_time=0.02", "--set",
             "simulation.record_time=0.06"]
     for flag in ("--no-crack", "--crack"):
         out = tmp_path / f"{flag}.nc"
-        r = subprocess.run([*args, flag, "--out", str(out)], capture_output=True, text=True,
-                           timeout=600)
+        r = run_geardyn([*args, flag, "--out", str(out)], timeout=600)
         assert r.returncode == 0, r.stderr
         with xr.open_dataset(out) as ds:
             if flag == "--no-crack":  # perfect teeth: no deviation recorded at all

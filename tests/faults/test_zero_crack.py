@@ -3,8 +3,6 @@ can start at 0 mm and compare every size with the healthy gear in one axis."""
 
 from __future__ import annotations
 
-import subprocess
-import sys
 import warnings
 
 import numpy as np
@@ -15,6 +13,8 @@ from geardyn.cache import cache_key
 from geardyn.stiffness import build_map, map_inputs
 from geardyn.stiffness.fe.model import _crack_of
 from geardyn.studies.sweep import parse_sweep
+
+from .._cli_fork import run_geardyn
 
 SMALL = {"stiffness.method": "pem", "stiffness.centre_distances": 3,
          "stiffness.nodes_per_segment": 12}
@@ -46,8 +46,8 @@ def test_zero_depth_is_accepted_by_validation_and_sweeps_negative_is_refused(tmp
     for depth, code in (("0 mm", 0), ("-1 mm", 2)):
         f = tmp_path / "case.toml"
         f.write_text(f'extends = "xue_howard"\n[crack]\ndepth = "{depth}"\n')
-        r = subprocess.run([sys.executable, "-m", "geardyn", "config", "validate", str(f)],
-                           capture_output=True, text=True, timeout=120)
+        r = run_geardyn(["config", "validate", str(f)],
+                        capture_output=True, text=True, timeout=120)
         assert r.returncode == code, r.stdout + r.stderr
         assert "Traceback" not in r.stderr
     assert "crack.depth" in r.stderr

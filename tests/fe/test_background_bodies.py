@@ -21,6 +21,8 @@ from geardyn.stiffness.fe.background import (
     fe_processes,
 )
 
+from .._cli_fork import run_geardyn
+
 #: a small FE case: coarse mesh, few grid lines (the bodies take about a second each)
 SMALL = {"stiffness.method": "fe", "stiffness.fe.refinement": 0.3,
          "stiffness.centre_distances": 3, "stiffness.nodes_per_segment": 6}
@@ -151,8 +153,6 @@ def test_available_memory_is_read_from_meminfo():
 @pytest.mark.slow
 def test_geardyn_stiffness_with_the_second_process(tmp_path):
     """Through the CLI, as a user runs it: the same maps as in one process, no process left."""
-    import subprocess
-    import sys
 
     import xarray as xr
 
@@ -162,9 +162,9 @@ def test_geardyn_stiffness_with_the_second_process(tmp_path):
         env = dict(os.environ, GEARDYN_FE_PROCESSES=n,
                    GEARDYN_CACHE_DIR=str(tmp_path / f"cache{n}"))
         out = tmp_path / f"out{n}"
-        r = subprocess.run([sys.executable, "-m", "geardyn", "stiffness", "--method", "fe",
-                            *sets, "--out", str(out)], capture_output=True, text=True, env=env,
-                           timeout=300)
+        r = run_geardyn(["stiffness", "--method", "fe",
+                         *sets, "--out", str(out)], capture_output=True, text=True, env=env,
+                        timeout=300)
         assert r.returncode == 0, r.stdout + r.stderr
         with xr.open_dataset(out / "stiffness_cracked.nc", engine="h5netcdf") as ds:
             outs[n] = ds["k_mb"].values.copy()

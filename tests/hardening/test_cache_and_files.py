@@ -12,6 +12,8 @@ import pytest
 
 from geardyn.cache import Cache, cache_key
 
+from .._cli_fork import run_geardyn
+
 BUILDER = textwrap.dedent("""
     import sys, time, pathlib
     from geardyn.cache import Cache
@@ -79,8 +81,8 @@ def test_damaged_entries_are_detected_and_rebuilt(tmp_path, damage):
 
 
 def _cli(*args, cwd=None):
-    return subprocess.run([sys.executable, "-m", "geardyn", *args], capture_output=True,
-                          text=True, timeout=300, cwd=cwd)
+    return run_geardyn([*args], capture_output=True,
+                       text=True, timeout=300, cwd=cwd)
 
 
 #: short records on a coarse PEM map: the files are tested here, not the stiffness method

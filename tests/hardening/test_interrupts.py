@@ -17,6 +17,8 @@ import time
 
 import pytest
 
+from .._cli_fork import run_geardyn
+
 pytestmark = [pytest.mark.slow, pytest.mark.timeout(3600)]
 
 #: An interrupted command ends with status 130, or by SIGINT when the Ctrl-C landed inside a
@@ -81,8 +83,8 @@ def test_ctrl_c_during_run_then_the_same_command_continues(tmp_path):
         assert json.loads((out / "summary.json").read_text())["complete"] is False
     # the same command, no --force: it continues into the folder, reusing the cached maps
     env.pop("GEARDYN_TEST_READY_FILE")
-    r = subprocess.run([sys.executable, "-m", "geardyn", "run", "--out", str(out), *RUN],
-                       env=env, capture_output=True, text=True, timeout=1800)
+    r = run_geardyn(["run", "--out", str(out), *RUN],
+                    env=env, capture_output=True, text=True, timeout=1800)
     assert r.returncode == 0, r.stderr
     assert "continuing the interrupted run" in r.stderr
     assert json.loads((out / "summary.json").read_text())["complete"] is True

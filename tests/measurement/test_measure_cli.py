@@ -5,11 +5,12 @@ from __future__ import annotations
 
 import json
 import os
-import subprocess
 import sys
 
 import pytest
 import xarray as xr
+
+from .._cli_fork import run_geardyn
 
 pytestmark = pytest.mark.slow  # each command starts a Python process (seconds under load)
 
@@ -21,8 +22,8 @@ SHORT = ["--stiffness", "pem", "--set", "simulation.settle_time=0.05",
 
 def run(*args, cache, cwd=None):
     env = {**os.environ, "GEARDYN_CACHE_DIR": str(cache)}
-    return subprocess.run(GEARDYN + list(args), capture_output=True, text=True, env=env,
-                          timeout=600, cwd=cwd)
+    return run_geardyn(list(args), capture_output=True, text=True, env=env,
+                       timeout=600, cwd=cwd)
 
 
 @pytest.mark.slow

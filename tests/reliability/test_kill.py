@@ -24,6 +24,7 @@ import pytest
 
 from geardyn.stiffness.map import StiffnessMap
 from geardyn.studies.sweep import STATUS_OK, open_sweep, verify_store
+from tests._cli_fork import run_geardyn
 from tests.sweep._procs import GEARDYN, env
 
 SMALL = ["--set", "stiffness.centre_distances=3", "--set", "stiffness.nodes_per_segment=5"]
@@ -90,8 +91,7 @@ def _stiffness_markers(cache: Path, out: Path) -> dict:
 def stiffness_reference(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("stiffness-ref")
     cmd = [*GEARDYN, "stiffness", "--method", "pem", "--out", str(tmp / "out"), *SMALL]
-    r = subprocess.run(cmd, capture_output=True, text=True, env=_env(tmp / "cache"),
-                       timeout=600, cwd=tmp)
+    r = run_geardyn(cmd[len(GEARDYN):], env=_env(tmp / "cache"), timeout=600, cwd=tmp)
     assert r.returncode == 0, r.stdout + r.stderr
     return {k: StiffnessMap.from_netcdf(tmp / "out" / f"stiffness_{k}.nc")
             for k in ("healthy", "cracked")}
@@ -109,8 +109,7 @@ def test_killed_stiffness_run_resumes_to_the_uninterrupted_result(tmp_path, stif
     # whatever is on disk after the kill is whole: every complete-looking file reads
     for f in out.glob("*.nc") if out.exists() else []:
         StiffnessMap.from_netcdf(f)
-    r = subprocess.run(cmd, capture_output=True, text=True, env=_env(cache), timeout=600,
-                       cwd=tmp_path)
+    r = run_geardyn(cmd[len(GEARDYN):], env=_env(cache), timeout=600, cwd=tmp_path)
     assert r.returncode == 0, f"killed at {name!r} ({killed}): {r.stdout}{r.stderr}"
     for k, ref in stiffness_reference.items():
         _same_map(StiffnessMap.from_netcdf(out / f"stiffness_{k}.nc"), ref)
@@ -172,9 +171,8 @@ def sweep_reference(tmp_path_factory):
     f = tmp / "sweep.toml"
     f.write_text(SWEEP)
     out = tmp / "reference.zarr"
-    r = subprocess.run([*GEARDYN, "sweep", str(f), "--out", str(out), "--workers", "1"],
-                       capture_output=True, text=True, env=_env(tmp / "cache"), timeout=900,
-                       cwd=tmp)
+    r = run_geardyn(["sweep", str(f), "--out", str(out), "--workers", "1"],
+                    env=_env(tmp / "cache"), timeout=900, cwd=tmp)
     assert r.returncode == 0, r.stdout + r.stderr
     return out
 
@@ -189,8 +187,7 @@ def test_killed_sweep_resumes_to_the_uninterrupted_result(tmp_path, sweep_refere
     name = list(markers)[np.random.default_rng([RNG_SEED, 10 + draw]).integers(len(markers))]
     cmd = [*GEARDYN, "sweep", str(f), "--out", str(out), "--workers", "1"]
     killed = _kill_at(cmd, tmp_path, cache, markers[name], tmp_path / "killed.log")
-    r = subprocess.run(cmd, capture_output=True, text=True, env=_env(cache), timeout=600,
-                       cwd=tmp_path)
+    r = run_geardyn(cmd[len(GEARDYN):], env=_env(cache), timeout=600, cwd=tmp_path)
     assert r.returncode == 0, f"killed at {name!r} ({killed}): {r.stdout}{r.stderr}"
     assert f"ok {N_RUNS}, failed 0, pending 0" in r.stdout
     assert verify_store(out).ok

@@ -10,7 +10,6 @@ runs may differ.
 from __future__ import annotations
 
 import shutil
-import subprocess
 
 import numpy as np
 import pytest
@@ -26,8 +25,10 @@ from geardyn.studies.sweep import (
 )
 from geardyn.studies.sweep.integrity import CHECKSUM_VAR, batch_digest
 from tests.sweep._evaluators import OscillatorEvaluator
-from tests.sweep._procs import GEARDYN, env
+from tests.sweep._procs import env
 from tests.sweep.conftest import OSC_SWEEP
+
+from .._cli_fork import run_geardyn
 
 LIMIT = 120.0  # N m: the 150 N m runs "diverge"
 RESULTS = ["status", "error", "warning", "x__amplitude", "x__static", "noise", "x__wave"]
@@ -151,18 +152,18 @@ def test_lost_array_metadata_is_a_clear_error(tmp_path, reference, client, lost)
 @pytest.mark.slow
 def test_cli_verify_reports_without_computing(tmp_path, reference):
     out = _copy(reference, tmp_path)
-    r = subprocess.run([*GEARDYN, "sweep", "--verify", str(out)], capture_output=True,
-                       text=True, env=env(), timeout=120)
+    r = run_geardyn(["sweep", "--verify", str(out)], capture_output=True,
+                    text=True, env=env(), timeout=120)
     assert r.returncode == 0 and "all match their checksums" in r.stdout, r.stdout + r.stderr
     shutil.copyfile(out / "noise" / "0", out / "noise" / "1")
     before = zarr.open_group(str(out), mode="r")["status"][:]
-    r = subprocess.run([*GEARDYN, "sweep", "--verify", str(out)], capture_output=True,
-                       text=True, env=env(), timeout=120)
+    r = run_geardyn(["sweep", "--verify", str(out)], capture_output=True,
+                    text=True, env=env(), timeout=120)
     assert r.returncode == 1, r.stdout + r.stderr
     assert "batch 1 (runs 5-9)" in r.stderr and "Traceback" not in r.stderr
     # nothing was changed by the check
     np.testing.assert_array_equal(zarr.open_group(str(out), mode="r")["status"][:], before)
-    r = subprocess.run([*GEARDYN, "sweep", "--verify", str(tmp_path)], capture_output=True,
-                       text=True, env=env(), timeout=120)
+    r = run_geardyn(["sweep", "--verify", str(tmp_path)], capture_output=True,
+                    text=True, env=env(), timeout=120)
     assert r.returncode == 2 and "not a Zarr store" in r.stderr and "Traceback" not in r.stderr
     assert len(r.stderr.strip().splitlines()) == 1

@@ -10,7 +10,6 @@ import json
 import os
 import shutil
 import subprocess
-import sys
 from html.parser import HTMLParser
 from pathlib import Path
 
@@ -20,6 +19,8 @@ import pytest
 import xarray as xr
 
 from geardyn.studies.paper_validation import validation_tables
+
+from .._cli_fork import run_geardyn
 
 pytestmark = pytest.mark.slow
 
@@ -38,9 +39,9 @@ def run_cache(tmp_path_factory):
 @pytest.fixture(scope="module")
 def run_dir(tmp_path_factory, run_cache):
     out = tmp_path_factory.mktemp("run") / "out"
-    r = subprocess.run([sys.executable, "-m", "geardyn", "run", "--out", str(out), *SHORT],
-                       capture_output=True, text=True, timeout=600,
-                       env={**os.environ, "GEARDYN_CACHE_DIR": str(run_cache)})
+    r = run_geardyn(["run", "--out", str(out), *SHORT],
+                    capture_output=True, text=True, timeout=600,
+                    env={**os.environ, "GEARDYN_CACHE_DIR": str(run_cache)})
     assert r.returncode == 0, r.stderr + r.stdout
     return out, r
 
@@ -152,10 +153,10 @@ def test_results_open_the_obvious_way_and_are_compressed(run_dir):
 
 def test_diagnose_accepts_what_run_writes(run_dir, tmp_path):
     out, _ = run_dir
-    r = subprocess.run([sys.executable, "-m", "geardyn", "diagnose",
-                        str(out / "runs" / "model_II_cracked.nc"), "--out", str(tmp_path / "d"),
-                        "--set", "diagnostics.samples_per_rev=1024"],
-                       capture_output=True, text=True, timeout=600)
+    r = run_geardyn(["diagnose",
+                     str(out / "runs" / "model_II_cracked.nc"), "--out", str(tmp_path / "d"),
+                     "--set", "diagnostics.samples_per_rev=1024"],
+                    capture_output=True, text=True, timeout=600)
     assert r.returncode == 0, r.stderr + r.stdout
     m = json.loads((tmp_path / "d" / "metrics.json").read_text())
     s = json.loads((out / "summary.json").read_text())
@@ -173,9 +174,9 @@ def test_diagnose_accepts_what_run_writes(run_dir, tmp_path):
     # the same diagnosis as the report's Table 3 for that record
     want = s["table3"]["gear_vertical_velocity"]["II"]["residual_kurtosis"]
     assert any(abs(x - want) <= 1e-6 * abs(want) for x in numbers(m))
-    r = subprocess.run([sys.executable, "-m", "geardyn", "diagnose", str(out / "results.nc"),
-                        "--out", str(tmp_path / "d2")], capture_output=True, text=True,
-                       timeout=120)
+    r = run_geardyn(["diagnose", str(out / "results.nc"),
+                     "--out", str(tmp_path / "d2")], capture_output=True, text=True,
+                    timeout=120)
     assert r.returncode == 2
     assert "runs" in r.stderr and "model_II_cracked.nc" in r.stderr and "Traceback" not in r.stderr
 
@@ -390,9 +391,9 @@ def test_model_comparison_recomputed_from_the_run_files(run_dir):
 @pytest.fixture(scope="module")
 def own_case_dir(tmp_path_factory):
     out = tmp_path_factory.mktemp("own") / "out"
-    r = subprocess.run([sys.executable, "-m", "geardyn", "run", "--out", str(out), *SHORT,
-                        "--set", "pinion.teeth=25"],
-                       capture_output=True, text=True, timeout=900)
+    r = run_geardyn(["run", "--out", str(out), *SHORT,
+                     "--set", "pinion.teeth=25"],
+                    capture_output=True, text=True, timeout=900)
     assert r.returncode == 0, r.stderr + r.stdout
     return out
 
@@ -424,9 +425,9 @@ def test_warm_rerun_uses_the_cache(run_dir, run_cache, tmp_path):
     cache = Path(run_cache)
     before = sorted(p.relative_to(cache) for p in cache.rglob("*.nc"))
     out2 = tmp_path / "again"
-    r = subprocess.run([sys.executable, "-m", "geardyn", "run", "--out", str(out2), *SHORT],
-                       capture_output=True, text=True, timeout=600,
-                       env={**os.environ, "GEARDYN_CACHE_DIR": str(cache)})
+    r = run_geardyn(["run", "--out", str(out2), *SHORT],
+                    capture_output=True, text=True, timeout=600,
+                    env={**os.environ, "GEARDYN_CACHE_DIR": str(cache)})
     assert r.returncode == 0, r.stderr + r.stdout
     after = sorted(p.relative_to(cache) for p in cache.rglob("*.nc"))
     assert before and after == before

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import os
 import signal
-import subprocess
 import textwrap
 import time
 
@@ -17,6 +16,7 @@ import pytest
 
 from geardyn.studies.sweep import STATUS_FAILED, STATUS_OK, evaluate_run, load_sweep, open_sweep
 
+from .._cli_fork import run_geardyn
 from ._procs import GEARDYN, dask_cluster, env
 
 SWEEP = textwrap.dedent("""
@@ -45,9 +45,9 @@ def test_sweep_on_a_real_scheduler_and_two_workers(tmp_path):
     f.write_text(SWEEP)
     out = tmp_path / "loopback.zarr"
     with dask_cluster(tmp_path, n_workers=2) as address:
-        r = subprocess.run([*GEARDYN, "sweep", str(f), "--out", str(out), "--scheduler",
-                            address], capture_output=True, text=True, env=env(), timeout=240,
-                           cwd=tmp_path)
+        r = run_geardyn(["sweep", str(f), "--out", str(out), "--scheduler",
+                         address], capture_output=True, text=True, env=env(), timeout=240,
+                        cwd=tmp_path)
     assert r.returncode == 0, r.stdout + r.stderr
     assert "ok 4, failed 4, pending 0" in r.stdout
     ds = open_sweep(out).load()

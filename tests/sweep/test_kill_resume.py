@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import os
 import signal
-import subprocess
 import textwrap
 import time
 
@@ -18,6 +17,7 @@ import zarr
 
 from geardyn.studies.sweep import STATUS_OK, STATUS_PENDING, load_sweep, open_sweep, run_sweep
 
+from .._cli_fork import run_geardyn
 from ._procs import GEARDYN, env, start, stop
 
 SWEEP = textwrap.dedent("""
@@ -86,8 +86,7 @@ def test_kill_and_resume_gives_the_uninterrupted_result(tmp_path, client):
     st = interrupt(signal.SIGINT, 2, "ctrl-c.log")
     st = interrupt(signal.SIGKILL, int((st == STATUS_OK).sum()) + 2, "killed.log")
 
-    r = subprocess.run(cmd, capture_output=True, text=True, env=env(), timeout=240,
-                       cwd=tmp_path)
+    r = run_geardyn(cmd[len(GEARDYN):], env=env(), timeout=240, cwd=tmp_path)
     assert r.returncode == 0, r.stdout + r.stderr
     assert "resumed" in r.stdout and f"ok {n}, failed 0, pending 0" in r.stdout
     done_before = int((st == STATUS_OK).sum())

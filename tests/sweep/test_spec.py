@@ -19,6 +19,8 @@ from scipy.stats import qmc
 from geardyn.errors import DataFileError, InputError
 from geardyn.studies.sweep import load_sweep, parse_sweep, run_seeds
 
+from .._cli_fork import run_geardyn
+
 
 def sweep(text: str, **kw):
     return parse_sweep(textwrap.dedent(text), **kw)
@@ -258,15 +260,14 @@ def test_long_axes_are_checked_at_their_bounds():
 
 
 def test_cli_refuses_a_huge_grid_in_one_line(tmp_path):
-    import subprocess
 
-    from ._procs import GEARDYN, env
+    from ._procs import env
 
     f = tmp_path / "huge.toml"
     f.write_text('[axes]\nmotor.torque = { start = "50 N m", stop = "150 N m", num = 1000000 }\n'
                  'load.speed = { start = "80 rad/s", stop = "150 rad/s", num = 1000000 }\n')
-    r = subprocess.run([*GEARDYN, "sweep", str(f), "--out", str(tmp_path / "o.zarr")],
-                       capture_output=True, text=True, env=env(), timeout=120)
+    r = run_geardyn(["sweep", str(f), "--out", str(tmp_path / "o.zarr")],
+                    capture_output=True, text=True, env=env(), timeout=120)
     assert r.returncode == 2 and "Traceback" not in r.stderr
     assert len(r.stderr.strip().splitlines()) == 1 and "1,000,000,000,000 runs" in r.stderr
     assert not (tmp_path / "o.zarr").exists()
