@@ -68,17 +68,20 @@ def test_choices_are_case_insensitive(tmp_path):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize(("case_method", "option", "expected"), [
-    ("fe", [], "fe map, healthy"),
-    ("pem", [], "pem map, healthy"),
-    ("pem", ["--method", "FE"], "fe map, healthy"),
+@pytest.mark.parametrize(("case_method", "option", "processes", "expected"), [
+    ("fe", [], "1", "fe map, healthy"),
+    ("fe", [], "0", "fe map, faulty bodies first"),
+    ("pem", [], "0", "pem map, healthy"),
+    ("pem", ["--method", "FE"], "1", "fe map, healthy"),
 ])
-def test_stiffness_uses_the_case_method_unless_told(tmp_path, case_method, option, expected):
+def test_stiffness_uses_the_case_method_unless_told(tmp_path, case_method, option, processes,
+                                                    expected):
     """The first stage the command starts names the method (read from the readiness file, then
-    the command is stopped: no need to build an FE map to know which method it builds)."""
+    the command is stopped: no need to build an FE map to know which method it builds). In one
+    process (``GEARDYN_FE_PROCESSES=0``) the FE map's faulty bodies come first."""
     ready = tmp_path / "ready"
     env = {**os.environ, "GEARDYN_CACHE_DIR": str(tmp_path / "c"),
-           "GEARDYN_TEST_READY_FILE": str(ready)}
+           "GEARDYN_TEST_READY_FILE": str(ready), "GEARDYN_FE_PROCESSES": processes}
     p = subprocess.Popen(GEARDYN + ["stiffness", "--out", str(tmp_path / "k"), "--set",
                                     f"stiffness.method={case_method}", *option],
                          env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)

@@ -64,6 +64,41 @@ def test_the_second_process_fills_the_cache_and_the_maps_are_the_same_bytes(case
 
 
 @pytest.mark.slow
+def test_one_process_builds_the_faulty_bodies_first(case, tmp_path, monkeypatch):
+    """Without a second process the context builds the faulty map's bodies before the block
+    (faulty body first, reported through ``progress`` to its full count); the block finds every
+    body in the cache and its maps are the bytes of a plain build; a cached faulty map or a
+    disabled cache builds nothing first."""
+    monkeypatch.setenv("GEARDYN_CACHE_DIR", str(tmp_path / "first"))
+    monkeypatch.setenv(FE_PROCESSES_ENV, "0")
+    calls = []
+    with record_lookups() as before:
+        with faulty_bodies_in_background(case, progress=lambda d, t: calls.append((d, t))) as b:
+            assert not b.started
+            built = [r for r in before if r["kind"] == "fe"]
+            with record_lookups() as inside:
+                first = _maps(case)
+    assert built and not built[0]["hit"]                     # built here, before the block
+    assert calls and calls[-1][0] == calls[-1][1] == len(built)
+    fe = [r for r in inside if r["kind"] == "fe"]
+    assert fe and all(r["hit"] for r in fe), fe              # the block only loads bodies
+    monkeypatch.setenv("GEARDYN_CACHE_DIR", str(tmp_path / "plain"))
+    plain = _maps(case)
+    for a, b in zip(plain, first, strict=True):
+        assert np.array_equal(a.k_mb, b.k_mb) and a.attrs["inputs_hash"] == b.attrs["inputs_hash"]
+    with record_lookups() as again:  # the faulty map is cached now: nothing is built first
+        with faulty_bodies_in_background(case):
+            pass
+    assert not [r for r in again if r["kind"] == "fe"]
+    monkeypatch.setenv("GEARDYN_NO_CACHE", "1")  # nothing to keep the bodies in: nothing first
+    monkeypatch.setenv("GEARDYN_CACHE_DIR", str(tmp_path / "off"))
+    with record_lookups() as off:
+        with faulty_bodies_in_background(case):
+            pass
+    assert not off and not (tmp_path / "off" / "fe").exists()
+
+
+@pytest.mark.slow
 def test_racing_the_second_process_gives_the_same_maps(case, tmp_path, monkeypatch):
     """No waiting: whichever process comes to a body first builds it (the entry's lock)."""
     monkeypatch.setenv("GEARDYN_CACHE_DIR", str(tmp_path / "race"))

@@ -94,17 +94,18 @@ def stiffness(
     from ..stiffness.plots import fig_crack, fig_load_sharing, fig_stiffness
 
     maps = {}
-    if method == "fe":  # a second process builds the faulty bodies meanwhile, where cores and
-        from ..stiffness.fe.background import faulty_bodies_in_background  # memory allow
-
-        background = faulty_bodies_in_background(case, method=method)
-    else:
-        background = contextlib.nullcontext(None)
     with progress_bar() as bar, warnings.catch_warnings(), record_lookups() as lookups, \
-            background:
+            contextlib.ExitStack() as stack:
         # the maps carry their validity notes in attrs["warnings"]; printed below once
         warnings.simplefilter("ignore", UserWarning)
         progress = StageProgress(bar)
+        if method == "fe":  # a second process builds the faulty bodies meanwhile where cores
+            # and memory allow; else this one builds them first (the largest body while the
+            # process is smallest)
+            from ..stiffness.fe.background import faulty_bodies_in_background
+
+            stack.enter_context(faulty_bodies_in_background(
+                case, method=method, progress=progress.stage("fe map, faulty bodies first")))
         for name, cracked in (("healthy", False), ("faulty" if has_faults else "cracked", True)):
             if cracked and not (has_crack or has_faults):
                 continue

@@ -102,9 +102,10 @@ def _build_map_with_progress(build_map, case: Case, cracked: bool, result: Study
     return m
 
 
-def _faulty_bodies_in_background(case: Case):
+def _faulty_bodies_in_background(case: Case, result: StudyResult):
     """:func:`geardyn.stiffness.fe.background.faulty_bodies_in_background`, imported only for
-    the FE method (the FE package takes 0.2 s to import)."""
+    the FE method (the FE package takes 0.2 s to import). Without a second process it builds
+    the faulty map's bodies first, under the progress bar ``stiffness (FE bodies)``."""
     import contextlib
 
     if case.stiffness.method != "fe":
@@ -115,7 +116,8 @@ def _faulty_bodies_in_background(case: Case):
     # after the bodies, the same process compiles the time-step kernel (a first run after an
     # install; otherwise it loads it in a fraction of a second) while this one evaluates the
     # maps and draws their figures
-    return faulty_bodies_in_background(case, then=(compile_kernels,))
+    return faulty_bodies_in_background(case, then=(compile_kernels,),
+                                       progress=result.sub_progress("stiffness (FE bodies)"))
 
 
 class _ImportedOnCall:
@@ -156,7 +158,7 @@ def stiffness_stage(case: Case, out: Path, result: StudyResult) -> None:
         result.notes.append("--quick: the stiffness maps are coarser than the case's ("
                             + ", ".join(what) + "); run without --quick for the case's own "
                             "maps.")
-    with warnings.catch_warnings(), _faulty_bodies_in_background(map_case):
+    with warnings.catch_warnings(), _faulty_bodies_in_background(map_case, result):
         # (a second process builds the cracked map's FE bodies meanwhile, where cores and
         # memory allow: geardyn.stiffness.fe.background)
         warnings.simplefilter("ignore")  # the maps record their warnings in attrs (read below)

@@ -245,6 +245,9 @@ def fig_pwvd_pair(diags: dict, sig: str, which: str, teeth: int, max_order: floa
         if pw.distribution.size == 0:  # a diagnosis kept without its distributions (memory):
             pw = _pwvd_again(diags[m], sd, which)  # the same PWVD, computed for this figure
         k = pw.orders <= max_order
+        n_k = int(np.count_nonzero(k))
+        if np.array_equal(k[:n_k], np.ones(n_k, bool)):  # ascending orders: a slice, no copy
+            k = slice(0, n_k)
         n_ang = pw.angle.size
         d = pw.distribution[:, k] if pw.distribution.shape[0] == n_ang else \
             pw.distribution[k, :].T
@@ -253,8 +256,13 @@ def fig_pwvd_pair(diags: dict, sig: str, which: str, teeth: int, max_order: floa
         # millions of cells took 0.9 s per figure, most of the run's figure time)
         o = pw.orders[k]
         step = o[1] - o[0] if o.size > 1 else 1.0
-        vmax = np.max(np.abs(d)) or 1.0
-        im = ax.imshow(d.T, origin="lower", aspect="auto", interpolation="nearest",
+        vmax = float(max(d.max(), -d.min())) or 1.0  # max |d| without an |d| array
+        # the image holds a float32 copy (display only: 8-bit colours), not a view of the
+        # float64 distribution, which is freed before the next model's is computed; matplotlib
+        # then scales in float32 too (a cold run's memory peak was drawing these figures)
+        img = np.ascontiguousarray(d.T, dtype=np.float32)
+        del pw, d
+        im = ax.imshow(img, origin="lower", aspect="auto", interpolation="nearest",
                        extent=(0.0, 360.0, o[0] - step / 2, o[-1] + step / 2),
                        cmap="viridis", vmin=0, vmax=vmax)
         ax.set_ylim(max(o[0] - step / 2, 0.0), o[-1] + step / 2)
