@@ -127,18 +127,27 @@ def run_geardyn(args, *, env: dict[str, str] | None = None, cwd=None, timeout: f
         if started is None or "pid" not in started:
             raise RuntimeError(f"the geardyn CLI fork server did not start {args}: {started}")
         deadline = None if timeout is None else time.monotonic() + timeout
-        done = _read_line(frm, deadline)
+        try:
+            done = _read_line(frm, deadline)
+        except BaseException:  # e.g. pytest-timeout: as subprocess.run, kill the command
+            _kill(started["pid"], frm)
+            raise
         if done is None:  # timed out: kill the command and whatever it started
-            try:
-                os.killpg(started["pid"], signal.SIGKILL)
-            except ProcessLookupError:
-                pass
-            _read_line(frm, None)
+            _kill(started["pid"], frm)
             raise subprocess.TimeoutExpired(cmd, timeout, out.read_text(errors="replace"),
                                             err.read_text(errors="replace"))
         return subprocess.CompletedProcess(cmd, done["returncode"],
                                            out.read_text(encoding="utf-8", errors="replace"),
                                            err.read_text(encoding="utf-8", errors="replace"))
+
+
+def _kill(pid: int, frm: int) -> None:
+    """Kill a command's process group and wait for the server to reap it."""
+    try:
+        os.killpg(pid, signal.SIGKILL)
+    except ProcessLookupError:
+        pass
+    _read_line(frm, time.monotonic() + 60)
 
 
 # --------------------------------------------------------------------------------- server

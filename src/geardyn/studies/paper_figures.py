@@ -246,7 +246,7 @@ def fig_pwvd_pair(diags: dict, sig: str, which: str, teeth: int, max_order: floa
             pw = _pwvd_again(diags[m], sd, which)  # the same PWVD, computed for this figure
         k = pw.orders <= max_order
         n_k = int(np.count_nonzero(k))
-        if np.array_equal(k[:n_k], np.ones(n_k, bool)):  # ascending orders: a slice, no copy
+        if k[:n_k].all():  # ascending orders: the kept ones are a slice (a view, no copy)
             k = slice(0, n_k)
         n_ang = pw.angle.size
         d = pw.distribution[:, k] if pw.distribution.shape[0] == n_ang else \
