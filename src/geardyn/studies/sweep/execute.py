@@ -195,6 +195,51 @@ def sweep_digest(sweep: Sweep, evaluator: Evaluator) -> str:
     return cache_key({"definition": sweep.definition(), "evaluator": evaluator.identity()})
 
 
+#: Loggers of the client's event loop and of Dask. On a Ctrl-C while the client waits,
+#: ``distributed.utils.sync`` schedules a ``cancel`` of the call on the loop (dask/distributed
+#: PR #5758, "Respect KeyboardInterrupt in sync"); when the call had not started, distributed
+#: 2026.8.0 logs "Exception in callback ... NameError: cannot access free variable 'future'"
+#: from the loop's thread, with a traceback, at any moment around the interrupt (seen once in
+#: CI, in tests/sweep/test_kill_resume.py): Dask's own noise, not the user's business.
+_LOOP_LOGGERS = ("tornado.application", "tornado.general", "asyncio", "distributed")
+
+
+class _HeldRecords:
+    """A logging filter that holds the records of the loggers it is attached to."""
+
+    def __init__(self):
+        self.records: list = []
+
+    def filter(self, record) -> bool:
+        self.records.append(record)
+        return False
+
+
+@contextlib.contextmanager
+def _loop_logs_held() -> Iterator[None]:
+    """Hold the records of :data:`_LOOP_LOGGERS` while the block runs: a block that ends
+    normally logs them afterwards, in order (nothing is lost); one that ends with an exception
+    (Ctrl-C included) drops them, and the loggers stay silent through the cluster's shutdown,
+    so the user sees the one line the CLI prints for it."""
+    import logging
+
+    held = _HeldRecords()
+    loggers = [logging.getLogger(name) for name in _LOOP_LOGGERS]
+    for lg in loggers:
+        lg.addFilter(held)
+    try:
+        yield
+    except BaseException:
+        for lg in loggers:
+            lg.setLevel(logging.CRITICAL + 1)
+        raise
+    finally:
+        for lg in loggers:
+            lg.removeFilter(held)
+    for record in held.records:
+        logging.getLogger(record.name).handle(record)
+
+
 @contextlib.contextmanager
 def _dask_client(scheduler: str | None, workers: int | None, client) -> Iterator[Any]:
     if client is not None:
@@ -211,7 +256,8 @@ def _dask_client(scheduler: str | None, workers: int | None, client) -> Iterator
             raise InputError("--scheduler", scheduler, f"the address of a running Dask "
                                                        f"scheduler ({exc})") from None
         try:
-            yield cl
+            with _loop_logs_held():
+                yield cl
         finally:
             cl.close()
         return
@@ -228,7 +274,8 @@ def _dask_client(scheduler: str | None, workers: int | None, client) -> Iterator
             signal.signal(signal.SIGINT, old)
     cl = Client(cluster)
     try:
-        yield cl
+        with _loop_logs_held():
+            yield cl
     finally:
         cl.close()
         cluster.close()
