@@ -34,7 +34,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from pathlib import Path
 
 import numpy as np
@@ -291,27 +291,85 @@ def _simulation_case(case: Case, quick: bool) -> Case:
                                 "simulation.record_time": min(sim.record_time, 0.3)})
 
 
+#: Variables a cached simulation record must hold (a damaged entry is rebuilt).
+_RECORD_REQUIRED = ("theta_p", "v_yg")
+
+
+def _simulation_key(case: Case, stiffness_map, model: str) -> str:
+    """Cache key of a simulation record: the case text, the map's inputs hash, the model and
+    the geardyn version."""
+    from .._version import __version__
+    from ..cache import cache_key
+
+    return cache_key({"case": case_to_toml(case), "map": stiffness_map.attrs.get("inputs_hash"),
+                      "model": model, "geardyn": __version__,
+                      "version": SIMULATION_CACHE_VERSION})
+
+
 def cached_simulation(case: Case, stiffness_map, model: str, cache=None):
     """:func:`geardyn.dynamics.simulate` through the on-disk cache (keyed by the case text, the
     map's inputs hash, the model and the geardyn version)."""
-    from .._version import __version__
-    from ..cache import cache_key, default_cache
+    from ..cache import default_cache
     from ..dynamics import simulate
     from .paper_cache import load_dataset, save_dataset
 
     cache = cache or default_cache()
-    key = cache_key({"case": case_to_toml(case), "map": stiffness_map.attrs.get("inputs_hash"),
-                     "model": model, "geardyn": __version__,
-                     "version": SIMULATION_CACHE_VERSION})
     # stored as .npz (:func:`.paper_cache.save_dataset`): the record read back is the one
     # computed, attribute types included, and it is written in milliseconds (a compressed
     # NetCDF took 0.13-0.28 s per record; the cache holds it uncompressed, about twice the bytes)
     ds, _ = cache.get_or_build(
-        "simulation", key, ".npz",
+        "simulation", _simulation_key(case, stiffness_map, model), ".npz",
         build=lambda: simulate(case, stiffness_map, model=model),
         save=save_dataset,
-        load=lambda path: load_dataset(path, required=("theta_p", "v_yg")))
+        load=lambda path: load_dataset(path, required=_RECORD_REQUIRED))
     return ds
+
+
+class CachedRecords(Mapping):
+    """``(model, state)`` -> simulation record (Dataset), read from the simulation cache at
+    each access instead of held in memory.
+
+    The cache's ``.npz`` is the record exactly as computed (:func:`.paper_cache.load_dataset`),
+    so every access returns equal data; an entry that went missing or was damaged since (a
+    ``geardyn cache prune`` meanwhile) is simulated again through the cache. A run holds one
+    or two records at a time instead of all seven (106 MB on the paper's case: the diagnostics
+    and measurement stages were the peak of a one-process run's memory). Without a disk cache
+    the records are held, as a dict would.
+    """
+
+    def __init__(self, cache=None):
+        from ..cache import default_cache
+
+        self._cache = cache or default_cache()
+        self._jobs: dict = {}
+        self._held: dict = {}
+
+    def add(self, key, ds, case: Case, stiffness_map, model: str) -> None:
+        """Record ``ds``, the cached simulation of ``model`` on ``case`` and ``stiffness_map``."""
+        self._jobs[key] = (case, stiffness_map, model)
+        if not self._cache.enabled:
+            self._held[key] = ds
+
+    def __getitem__(self, key):
+        if key in self._held:
+            return self._held[key]
+        case, stiffness_map, model = self._jobs[key]
+        from .paper_cache import load_dataset
+
+        ckey = _simulation_key(case, stiffness_map, model)
+        path = self._cache.path("simulation", ckey, ".npz")
+        if self._cache.valid(path, ckey):  # its checksum, as the cache checks it
+            try:
+                return load_dataset(path, required=_RECORD_REQUIRED)
+            except Exception:  # noqa: BLE001 - unreadable: the cache discards and rebuilds it
+                pass
+        return cached_simulation(case, stiffness_map, model, cache=self._cache)
+
+    def __iter__(self):
+        return iter(self._jobs)
+
+    def __len__(self) -> int:
+        return len(self._jobs)
 
 
 def _crack_angle(case: Case, result: StudyResult) -> float | None:
@@ -389,7 +447,8 @@ def simulation_stage(case: Case, out: Path, result: StudyResult) -> None:
     from . import paper_figures as pf
 
     sim_case = _simulation_case(case, result.quick)
-    runs = {}
+    runs = {}  # held for this stage's figures and numbers; the later stages read `records`
+    records = CachedRecords()
     jobs = [("I", "cracked"), ("I-static", "cracked"), ("II", "cracked"), ("I", "healthy"),
             ("I-static", "healthy"), ("II", "healthy"), ("II-start", "cracked")]
     rev = 2 * math.pi / (case.load.speed or 114.14)
@@ -403,16 +462,17 @@ def simulation_stage(case: Case, out: Path, result: StudyResult) -> None:
                  else "model II, paper's start-of-step scheme")
         result.emit(f"simulation: {label}", i, total)
         if model == "II-start":
-            ds = cached_simulation(scheme_case, result.maps[state], "II")
+            job = (scheme_case, result.maps[state], "II")
         else:
-            ds = cached_simulation(sim_case if state == "cracked" else healthy_case,
-                                   result.maps[state], model)
+            job = (sim_case if state == "cracked" else healthy_case, result.maps[state], model)
+        ds = cached_simulation(*job)
         runs[(model, state)] = ds
+        records.add((model, state), ds, *job)
         path = out / "runs" / run_file_name(model, state)
         _write_run_file(ds, path)
         result.files[f"run {model} {state}"] = path
         result.emit(f"simulation: {label}", i + 1, total)
-    result.sims = runs
+    result.sims = records
 
     ds2 = runs[("II", "cracked")]
     summ = {f"model_{m}_{st}": sim_summary(ds) for (m, st), ds in runs.items()}

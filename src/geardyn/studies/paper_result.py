@@ -59,8 +59,9 @@ class StudyResult:
         See the module docstring.
     quick : bool
         Shorter records.
-    sims : dict
-        ``(model, state)`` -> simulation Dataset.
+    sims : Mapping
+        ``(model, state)`` -> simulation Dataset (:class:`~.paper.CachedRecords` after the
+        simulation stage: each access reads the record from the simulation cache).
     diagnoses : dict
         ``(model, state)`` -> diagnosis result.
     crack_angle_rad : float, optional
