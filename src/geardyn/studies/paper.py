@@ -32,6 +32,7 @@ report stage; the report reads the :class:`~.paper_result.StudyResult`, the publ
 
 from __future__ import annotations
 
+import contextlib
 import math
 import time
 from collections.abc import Callable, Mapping
@@ -358,11 +359,11 @@ class CachedRecords(Mapping):
 
         ckey = _simulation_key(case, stiffness_map, model)
         path = self._cache.path("simulation", ckey, ".npz")
-        if self._cache.valid(path, ckey):  # its checksum, as the cache checks it
-            try:
+        # its checksum first, as the cache checks it; unreadable or gone, cached_simulation
+        # discards and rebuilds it
+        with contextlib.suppress(Exception):
+            if self._cache.valid(path, ckey):
                 return load_dataset(path, required=_RECORD_REQUIRED)
-            except Exception:  # noqa: BLE001 - unreadable: the cache discards and rebuilds it
-                pass
         return cached_simulation(case, stiffness_map, model, cache=self._cache)
 
     def __iter__(self):
