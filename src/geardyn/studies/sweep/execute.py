@@ -217,10 +217,10 @@ class _HeldRecords:
 
 @contextlib.contextmanager
 def _loop_logs_held() -> Iterator[None]:
-    """Hold the records of :data:`_LOOP_LOGGERS` while the block runs: a block that ends
-    normally logs them afterwards, in order (nothing is lost); one that ends with an exception
-    (Ctrl-C included) drops them, and the loggers stay silent through the cluster's shutdown,
-    so the user sees the one line the CLI prints for it."""
+    """Hold the records of :data:`_LOOP_LOGGERS` while the block runs (the client's use and
+    its shutdown): a block that ends normally logs them afterwards, in order (nothing is lost);
+    one that ends with an exception (Ctrl-C included) drops them, so the user sees the one line
+    the CLI prints for it. The loggers are as they were afterwards."""
     import logging
 
     held = _HeldRecords()
@@ -229,14 +229,10 @@ def _loop_logs_held() -> Iterator[None]:
         lg.addFilter(held)
     try:
         yield
-    except BaseException:
-        for lg in loggers:
-            lg.setLevel(logging.CRITICAL + 1)
-        raise
     finally:
         for lg in loggers:
             lg.removeFilter(held)
-    for record in held.records:
+    for record in held.records:  # only after a normal end
         logging.getLogger(record.name).handle(record)
 
 
@@ -255,11 +251,11 @@ def _dask_client(scheduler: str | None, workers: int | None, client) -> Iterator
         except OSError as exc:
             raise InputError("--scheduler", scheduler, f"the address of a running Dask "
                                                        f"scheduler ({exc})") from None
-        try:
-            with _loop_logs_held():
+        with _loop_logs_held():  # the shutdown included
+            try:
                 yield cl
-        finally:
-            cl.close()
+            finally:
+                cl.close()
         return
     n = workers or os.cpu_count() or 1
     # the worker processes ignore Ctrl-C (SIGINT reaches the whole terminal process group):
@@ -273,12 +269,12 @@ def _dask_client(scheduler: str | None, workers: int | None, client) -> Iterator
         if main:
             signal.signal(signal.SIGINT, old)
     cl = Client(cluster)
-    try:
-        with _loop_logs_held():
+    with _loop_logs_held():  # the shutdown included
+        try:
             yield cl
-    finally:
-        cl.close()
-        cluster.close()
+        finally:
+            cl.close()
+            cluster.close()
 
 
 def run_sweep(
