@@ -293,6 +293,34 @@ def test_tooth_crack_runs_through_the_tooth(tooth_paths):
 
 
 @pytest.mark.slow
+def test_crack_below_the_paris_threshold_arrests(tooth_paths):
+    """Delta K_eq at or below Delta K_th: the Paris rate is zero, so the crack does not grow
+    (the QA's ``--paris-threshold "200 MPa m^0.5"`` reported a crack grown to the outline over
+    infinitely many cycles). Oracle: the unthresholded path of the same crack and load
+    (``tooth_paths``): a threshold above its first K_eq stops at the initial tip, one just
+    below it changes nothing in the first steps."""
+    import geardyn
+    from geardyn.faults.tooth_growth import grow_tooth_crack, hpstc_roll
+    from geardyn.stiffness.fe.mesh import CrackGeometry
+
+    g, paths = tooth_paths
+    free = paths[1e-3]
+    pair = geardyn.paper_case().gear_pair()
+    kw = {"load": 100e3, "load_roll": hpstc_roll(pair), "n_steps": 2, "step": 1e-3,
+          "paris": (paris_c_from_mpa(1e-11, 3.0), 3.0)}
+    crack = CrackGeometry(0.5e-3, math.radians(45))
+    k0 = free.K_eq[0]
+    stopped = grow_tooth_crack(g, STEEL, crack, paris_threshold=1.0001 * k0, **kw)
+    assert "arrests" in stopped.stop and stopped.length.size == 1
+    assert stopped.points.shape == (2, 2) and np.allclose(stopped.points, free.points[:2])
+    assert stopped.cycles.tolist() == [0.0]
+    going = grow_tooth_crack(g, STEEL, crack, paris_threshold=0.9999 * k0, **kw)
+    assert "arrests" not in going.stop and going.length.size == 3
+    assert np.allclose(going.K_eq, free.K_eq[:3], rtol=1e-12)
+    assert np.all(np.isfinite(going.cycles)) and np.all(np.diff(going.cycles) > 0)
+
+
+@pytest.mark.slow
 def test_backup_ratio_one_still_breaks_the_tooth():
     """Lewicki & Ballarini's second solid case: backup ratio 1.0 (the paper's pinion with its
     bore raised to leave a rim one tooth height thick) also gives a tooth fracture in their

@@ -11,6 +11,7 @@ fourth moment; odd moments of the noise vanish).
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 import pytest
@@ -204,6 +205,48 @@ def test_healthy_fm4_against_housing_damping(measured_study):
     assert near and all(z <= 0.02 for z in near), near
     text = " ".join(housing_statements(hd))
     assert "within 0.5 of 3" in text and all(f"{100 * z:g}%" in text for z in near)
+
+
+@pytest.mark.slow
+def test_housing_damping_needs_two_revolutions_after_the_lead_in(measured_study):
+    """A record long enough for a damping ratio's lead-in and tail but leaving one whole
+    revolution after them is not averaged (a one-revolution TSA is no average, and not what the
+    other ratios compute): that ratio is not computed, with the reason, and no warning reaches
+    the user (``geardyn run --quick`` printed "TSA over only 1 whole revolution(s)" out of
+    context). Oracle: the case's lead-in ``L(zeta)`` (the chain's own) and revolution period
+    decide which ratios keep at least 2 revolutions in ``T - 2 L``; those are computed."""
+    from geardyn.studies.measure import chain_from_config
+    from geardyn.studies.paper import cached_simulation
+    from geardyn.studies.paper_measurement import HOUSING_DAMPING, housing_damping_sweep
+
+    case, result = measured_study
+    err = case.with_overrides(DEFAULT_ERRORS)
+    shaft = "p" if chain_from_config(case.measurement).tach.shaft == "pinion" else "g"
+    records = {}
+    for state in ("healthy", "cracked"):
+        ds = cached_simulation(err, result.maps[state], "II")
+        t = ds["time"].values
+        t_rev = 2 * math.pi / float(np.mean(ds[f"omega_{shaft}"].values))
+        records[state] = (err, ds.isel(time=np.flatnonzero(t <= t[0] + 0.3)), result.maps[state])
+    freqs = case.measurement.mode_frequencies
+    span = {}
+    for zeta in HOUSING_DAMPING:
+        chain = chain_from_config(case.measurement.model_copy(
+            update={"mode_damping_ratios": [zeta] * len(freqs)}))
+        # revolutions left after the lead-in and tail, before the pulses' phase is counted
+        span[zeta] = (0.3 - chain.lead_in() - chain.tail()) / t_rev
+    one = [z for z in HOUSING_DAMPING if 1 < span[z] < 2]
+    assert one, span  # the record length makes at least one ratio a one-revolution case
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        hd = housing_damping_sweep(err, records, case.pinion.teeth)
+    for z in HOUSING_DAMPING:
+        fm = hd["healthy"]["FM4"][HOUSING_DAMPING.index(z)]
+        if span[z] >= 3:  # two whole revolutions whatever the pulse phase
+            assert math.isfinite(fm), (z, hd.get("not_computed"))
+        if span[z] < 2:
+            assert math.isnan(fm) and f"{z:g}" in hd["not_computed"], (z, hd)
+    assert any("whole revolution" in hd["not_computed"][f"{z:g}"] for z in one)
 
 
 def test_housing_statements_follow_the_numbers():

@@ -338,6 +338,9 @@ def test_summary_says_nowhere_with_the_range_when_nothing_exceeds():
     assert s["sentence"].startswith("Nowhere in the range explored")
     assert "1e+05..1e+07 N/m" in s["sentence"] and "10..100 rad/s" in s["sentence"]
     assert "5 %" in s["sentence"]  # the largest ratio found, in per cent
+    # one damping ratio is said as one value, not as the range "2..2 % (1 values)"
+    assert "damping ratio 2 % (1 value)" in s["ranges"] and "2..2" not in s["ranges"]
+    assert "(2 values, both bearings)" in s["ranges"]
 
 
 def test_summary_says_where_it_exceeds():

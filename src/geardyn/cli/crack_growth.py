@@ -136,8 +136,8 @@ def crack_growth(
     paris_m: Annotated[float | None, typer.Option(
         "--paris-m", help="Paris exponent m [-] (required).", show_default=False)] = None,
     paris_threshold: Annotated[str, typer.Option(
-        "--paris-threshold", help="Threshold Delta K_th, e.g. '2 MPa m^0.5' (growth stops "
-                                  "below it).")] = "0",
+        "--paris-threshold", help="Threshold Delta K_th, e.g. '2 MPa m^0.5' (the crack arrests "
+                                  "where Delta K_eq is at or below it).")] = "0",
     steps: Annotated[int | None, typer.Option(
         "--steps", help="Largest number of growth steps (default 60, --quick 20); growth stops "
                         "earlier when the tip comes within one step of the outline.",
@@ -265,10 +265,13 @@ def crack_growth(
     n = ds["cycles"].values
     fm4 = ds["v_yg__FM4"].values if "v_yg__FM4" in ds else np.array([np.nan])
     ok = int(np.sum(ds["simulation_status"].values == "ok"))
+    finite = n[np.isfinite(n)]  # an arrested crack's last length takes infinitely many cycles
+    cycles = (f"{finite.max():.4g} cycles" + (" (then arrested)" if finite.size < n.size else "")
+              if finite.size else "no countable cycles")
     console.print(
         f"[green]wrote[/green] {', '.join(RESULTS)} -> {folder}/: crack "
         f"{a[0] * 1e3:.3g} -> {a[-1] * 1e3:.3g} mm in {a.size - 1} steps over "
-        f"{np.nanmax(n):.4g} cycles ({ds.attrs['stop']}); K_I {ds['K_I'].values[0] / 1e6:.3g} -> "
+        f"{cycles} ({ds.attrs['stop']}); K_I {ds['K_I'].values[0] / 1e6:.3g} -> "
         f"{ds['K_I'].values[-1] / 1e6:.3g} MPa m^0.5; v_yg FM4 {fm4[0]:.3g} -> {fm4[-1]:.3g} "
         f"(healthy {float(ds['v_yg__FM4_healthy']) if 'v_yg__FM4_healthy' in ds else np.nan:.3g})"
         f" at {ok}/{ds.sizes['sample_length']} simulated lengths", soft_wrap=True)

@@ -270,7 +270,9 @@ def grow_tooth_crack(gear: Gear, material: ElasticMaterial, crack: CrackGeometry
     paris : (C, m), optional
         Paris constants, ``C`` in m/cycle/(Pa m^0.5)^m; no default.
     paris_threshold : float
-        ``Delta K_th`` [Pa m^0.5].
+        ``Delta K_th`` [Pa m^0.5]. With ``paris``, the growth stops at the first length whose
+        ``Delta K_eq`` is at or below it (the crack arrests: the Paris rate is zero there, so
+        no load cycle takes the crack further and the path beyond would never be reached).
     progress : callable, optional
         ``progress(done, total)`` per analysed tip.
 
@@ -337,6 +339,10 @@ def grow_tooth_crack(gear: Gear, material: ElasticMaterial, crack: CrackGeometry
         th = mts_angle(sif.K_I, sif.K_II)
         rec["theta"].append(th)
         rec["K_eq"].append(float(equivalent_k(sif.K_I, sif.K_II)))
+        if paris is not None and rec["K_eq"][-1] <= paris_threshold:
+            stop = (f"Delta K_eq {rec['K_eq'][-1] / 1e6:.3g} MPa m^0.5 at or below the "
+                    f"threshold {paris_threshold / 1e6:.3g} MPa m^0.5: the crack arrests")
+            break
         if k == n_steps:
             break
         c, s = math.cos(th), math.sin(th)

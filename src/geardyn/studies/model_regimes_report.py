@@ -62,6 +62,18 @@ def _point_text(ds, idx) -> str:
             f"{_crack_label(float(ds.crack_depth.values[c]))}")
 
 
+
+def _span(values, fmt: str) -> str:
+    """``lo..hi`` of ``values`` in format ``fmt``, or the one value when they are all equal."""
+    lo, hi = float(np.min(values)), float(np.max(values))
+    return format(lo, fmt) if lo == hi else f"{format(lo, fmt)}..{format(hi, fmt)}"
+
+
+def _count(values) -> str:
+    """``n values`` (``1 value``)."""
+    n = int(np.size(values))
+    return f"{n} value" + ("" if n == 1 else "s")
+
 def regime_summary(ds) -> dict:
     """The findings of a study Dataset, computed from its values (threshold ``ds.threshold``).
 
@@ -103,12 +115,12 @@ def regime_summary(ds) -> dict:
     out["failed"] = int(((~not_run) & ~_ok(ds)).sum())
     k = ds.bearing_stiffness.values
     w = ds.pinion_speed.values
+    z = 100 * ds.damping_ratio.values
+    fm = ds.mesh_frequency.values
     out["ranges"] = (
-        f"bearing stiffness {k.min():.3g}..{k.max():.3g} N/m ({k.size} values, both bearings), "
-        f"bearing damping ratio {100 * ds.damping_ratio.values.min():g}.."
-        f"{100 * ds.damping_ratio.values.max():g} % ({ds.damping_ratio.size} values), pinion "
-        f"speed {w.min():.3g}..{w.max():.3g} rad/s ({w.size} values, mesh frequency "
-        f"{ds.mesh_frequency.values.min():.4g}..{ds.mesh_frequency.values.max():.4g} Hz), "
+        f"bearing stiffness {_span(k, '.3g')} N/m ({_count(k)}, both bearings), "
+        f"bearing damping ratio {_span(z, 'g')} % ({_count(z)}), pinion "
+        f"speed {_span(w, '.3g')} rad/s ({_count(w)}, mesh frequency {_span(fm, '.4g')} Hz), "
         + ", ".join(_crack_label(float(c)) for c in ds.crack_depth.values)
         + f"; input torque {ds.attrs.get('input_torque', math.nan):g} N m, "
           f"{ds.attrs.get('stiffness_method', '')} stiffness")

@@ -36,6 +36,7 @@ Module layout: imports the measurement chain, the diagnostics and the cache, nev
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Callable
 
 import numpy as np
@@ -293,14 +294,15 @@ def housing_damping_sweep(case: Case, records: dict, teeth: int,
         ``mesh_period_s`` (mean speed of the healthy record), ``decay_over_mesh_period`` (the
         lowest mode's decay time ``1 / (zeta 2 pi f)`` over the mesh period [-]) and
         ``healthy`` / ``cracked``: indicator -> list over the damping ratios (NaN where the
-        record is too short for the path's memory at that damping, the reason under
+        record is too short for the path's memory at that damping, or leaves fewer than two
+        whole revolutions after the chain's lead-in and tail, the reason under
         ``not_computed``); or ``skipped``.
     """
     from ..config import MeasurementConfig
-    from ..diagnostics import tach_pulse_times, tsa
+    from ..diagnostics import DiagnosticsWarning, tach_pulse_times, tsa
     from ..diagnostics.metrics import central_moment
     from ..diagnostics.spectra import residual
-    from ..errors import GeardynError
+    from ..errors import GeardynError, InputError
     from .measure import chain_from_config, housing_forces
 
     cfg = case.measurement if case.measurement is not None else MeasurementConfig()
@@ -330,8 +332,15 @@ def housing_damping_sweep(case: Case, records: dict, teeth: int,
                 m = chain.measure(ds["time"].values, forces[state],
                                   ds[f"theta_{shaft}"].values, ds[f"omega_{shaft}"].values)
                 tp = tach_pulse_times(m.tach, fs=m.fs) if np.ptp(m.tach) > 0 else np.empty(0)
-                avgs[state] = tsa(m.acc, tach_times=tp, fs=m.fs,
-                                  samples_per_rev=d.samples_per_rev, min_revolutions=2).average
+                with warnings.catch_warnings():  # fewer than 2 revolutions: said below instead
+                    warnings.filterwarnings("ignore", "TSA over only", DiagnosticsWarning)
+                    t = tsa(m.acc, tach_times=tp, fs=m.fs, samples_per_rev=d.samples_per_rev,
+                            min_revolutions=2)
+                if t.n_averages < 2:  # one revolution is no average: not the other ratios' TSA
+                    raise InputError("time", f"{m.acc.size / m.fs:.3g} s measured (after the "
+                                     f"chain's lead-in and tail), {t.n_averages} whole "
+                                     "revolution", "at least 2 whole revolutions for a TSA")
+                avgs[state] = t.average
         except GeardynError as exc:  # a lightly damped path's memory outlasts a short record
             out.setdefault("not_computed", {})[f"{zeta:g}"] = str(exc)
             for state in ("healthy", "cracked"):
@@ -567,8 +576,8 @@ def housing_statements(hd: dict | None) -> list[str]:
     if hd.get("not_computed"):
         text += ("Not computed at " + ", ".join(f"{100 * float(k):g}%" for k in
                                                 hd["not_computed"])
-                 + ": the record is too short for that path's memory (lengthen "
-                 "simulation.record_time). ")
+                 + ": the record is too short for that path's memory (lead-in and tail) and "
+                 "a TSA over two revolutions (lengthen simulation.record_time). ")
     if near:
         text += ("FM4 is within " f"{GAUSSIAN_FM4_BAND:g} of 3, the value of a Gaussian "
                  "difference signal, at " + ", ".join(f"{100 * z[i]:g}%" for i in near)

@@ -102,6 +102,23 @@ MODEL_COMPARISON_VARIABLES = ("rms_ii_minus_i_static", "rms_ii_minus_i", "explai
                               "top_share")
 
 
+def command_line(argv: list[str] | None = None) -> str:
+    """The command that made this report, as a user would type it again: ``geardyn ...`` when
+    the process is the CLI (the ``geardyn`` script or ``python -m geardyn``, whose ``argv[0]``
+    is the path of ``__main__.py``), arguments quoted for a POSIX shell; else the script that
+    called the library."""
+    import shlex
+
+    argv = list(sys.argv if argv is None else argv)
+    if not argv or not argv[0]:
+        return "(library call)"
+    prog = Path(argv[0])
+    as_module = prog.name == "__main__.py" and prog.parent.name == "geardyn"
+    if as_module or prog.name in ("geardyn", "geardyn.exe"):
+        return shlex.join(["geardyn", *argv[1:]])
+    return f"(library call from {shlex.join(argv)})"
+
+
 def _versions() -> list[tuple[str, str]]:
     return package_versions()
 
@@ -736,7 +753,7 @@ def report_stage(case: Case, out: Path, result: StudyResult) -> None:
     times.append(["total", sum(v for k, v in result.seconds.items() if k != "report") + t_rep])
     rep.table(["stage", "wall time [s]"], times, caption="Time per stage")
     rep.table(["package", "version"], _versions(), caption="Versions")
-    rep.paragraph(f"Command line: {' '.join(sys.argv) or '(library call)'}.")
+    rep.paragraph(f"Command line: {command_line()}.")
     rep.heading("Citations")
     cites = list(CITATIONS)
     for m in result.maps.values():
