@@ -59,10 +59,12 @@ __all__ = [
     "paper_case",
     "case_to_toml",
     "case_schema",
+    "case_file_schema",
     "parse_overrides",
     "PAPER_CASE",
     "CaseDetails",
     "load_case_details",
+    "with_written_value",
     "case_to_display_toml",
     "read_case_text",
     "parse_case_toml",
@@ -1113,6 +1115,7 @@ def load_case_details(path: str | Path | None = None,
     layers = _shipped_layer(PAPER_CASE, ()) if path is None else _file_layer(Path(path), ())
     data, prov, origin = layers.data, layers.prov, layers.origin
     ov = dict(overrides) if isinstance(overrides, Mapping) else parse_overrides(overrides)
+    before = copy.deepcopy(data) if ov else data  # to tell a change from a repeated value
     for key, value in ov.items():
         if isinstance(overrides, Mapping):
             check_text(key, "--set")
@@ -1124,18 +1127,87 @@ def load_case_details(path: str | Path | None = None,
         _drop_under(origin, key)
         prov[key] = override_source
         origin[key] = override_source
-    changed = [k for k in ov if k not in _UNSOURCED]
+    data["provenance"] = prov
+    case = _validate(data)
+    changed = _changed_keys(before, case, [k for k in ov if k not in _UNSOURCED])
     if changed and "name" not in ov:  # no longer the named case: say so
         data["name"] = f"{data.get('name', 'case')} (modified)"
         if "description" not in ov:
             keys = ", ".join(changed[:6]) + (", ..." if len(changed) > 6 else "")
             data["description"] = f"{data.get('description', '')} [changed by {override_source}: " \
                                   f"{keys}]".strip()
-    data["provenance"] = prov
-    case = _validate(data)
+        case = _validate(data)
     origin = {**{k: "default" for k, _ in _model_leaves(case) if k not in _UNSOURCED}, **origin}
     written = {k: v for k, v in data.items() if k != "provenance"}
     return CaseDetails(case=case, written=written, origin=origin)
+
+
+_MISSING = object()
+
+
+def _value_at(case: BaseModel, key: str) -> Any:
+    """The validated value at a dotted key (``faults.0.depth`` indexes the list), or _MISSING."""
+    node: Any = case
+    for p in key.split("."):
+        if isinstance(node, BaseModel) and p in type(node).model_fields:
+            node = getattr(node, p)
+        elif isinstance(node, list) and p.isdigit() and int(p) < len(node):
+            node = node[int(p)]
+        elif isinstance(node, dict) and p in node:
+            node = node[p]
+        else:
+            return _MISSING
+    return node
+
+
+def _same(a: Any, b: Any) -> bool:
+    """Equal validated values (floats to 1e-12 relative: '5 mm' and 0.005 are the same)."""
+    if isinstance(a, BaseModel) and isinstance(b, BaseModel):
+        a, b = a.model_dump(), b.model_dump()
+    if isinstance(a, dict) and isinstance(b, dict):
+        return a.keys() == b.keys() and all(_same(a[k], b[k]) for k in a)
+    if isinstance(a, list | tuple) and isinstance(b, list | tuple):
+        return len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b, strict=True))
+    if isinstance(a, float) and isinstance(b, float):
+        return a == b or math.isclose(a, b, rel_tol=1e-12, abs_tol=0.0)
+    return type(a) is type(b) and a == b
+
+
+def _changed_keys(before: dict[str, Any], case: Case, keys: list[str]) -> list[str]:
+    """The override ``keys`` whose validated value differs from the case without overrides
+    (every key when that case is not valid on its own, e.g. a partial file completed by --set).
+    A value set to what the case already has (``--set crack.depth="5 mm"`` on the paper's case)
+    is no change."""
+    if not keys:
+        return []
+    try:
+        base = _validate(before)
+    except InputError:
+        return keys
+    out = []
+    for k in keys:
+        old, new = _value_at(base, k), _value_at(case, k)
+        if old is _MISSING or new is _MISSING or not _same(old, new):
+            out.append(k)
+    return out
+
+
+def with_written_value(exc: InputError, details: CaseDetails) -> InputError:
+    """``exc`` with its value as the user wrote it when that was a quantity with a unit, the SI
+    value beside (``crack.depth: got '50 mm (= 0.05 m)'``); else ``exc`` itself."""
+    dim = _field_dimension(exc.field) if isinstance(exc.field, str) else None
+    written = _raw_value(details.written, tuple(exc.field.split(".")), None) if dim else None
+    if not isinstance(written, str) or isinstance(exc.value, bool) \
+            or not isinstance(exc.value, int | float):
+        return exc
+    si = format_si(exc.value, dim)
+    number, _, unit = written.strip().partition(" ")
+    try:
+        plain = unit.strip() == DIMENSIONS[dim].si_unit and float(number) == exc.value
+    except ValueError:
+        plain = False
+    value = written if plain else f"{written} (= {si})"
+    return type(exc)(exc.field, value, exc.allowed)
 
 
 def load_case(path: str | Path | None = None, overrides: Iterable[str] | Mapping[str, Any] = (),
@@ -1300,9 +1372,102 @@ def case_to_display_toml(details: CaseDetails) -> str:
     return _dumps(tree)
 
 
+#: Keys of a ``{ value = ..., source = ... }`` table, as the JSON schema describes them.
+_SOURCE_TABLE_KEYS = {
+    "source": {"type": "string", "description": "Where the value comes from (kept as its "
+                                                "provenance)."},
+    "note": {"description": "Appended to the source in parentheses."},
+    "si": {"description": "Written by 'geardyn config show' (the SI value); ignored on loading."},
+    "origin": {"description": "Written by 'geardyn config show' (where the value was given); "
+                              "ignored on loading."},
+}
+#: Models whose tables sit in a list (``[[faults]]``): a list replaces its base's whole, so
+#: their required keys stay required, and their values cannot be ``{ value, source }`` tables
+#: (only tables are searched for them, not lists).
+_LIST_ITEM_MODELS = frozenset({"FaultConfig"})
+
+
+def _sourced(schema: dict[str, Any]) -> dict[str, Any]:
+    """``schema``, or the same value written as a ``{ value = ..., source = ... }`` table."""
+    meta = {k: schema[k] for k in ("title", "description", "default") if k in schema}
+    table = {"type": "object", "properties": {"value": schema, **_SOURCE_TABLE_KEYS},
+             "required": ["value"], "additionalProperties": False}
+    return {**meta, "anyOf": [schema, table]}
+
+
+def _def_refs(schema: Any) -> list[str]:
+    """Names of the ``$defs`` a property refers to directly or through ``anyOf`` (not through
+    ``items``: list entries are not merged with a base)."""
+    if not isinstance(schema, dict):
+        return []
+    ref = schema.get("$ref", "")
+    out = [ref.rsplit("/", 1)[1]] if ref.startswith("#/$defs/") else []
+    for sub in schema.get("anyOf", ()):
+        out += _def_refs(sub)
+    return out
+
+
+def case_file_schema() -> dict[str, Any]:
+    """JSON schema (draft 2020-12) of case *files*, as :func:`load_case` reads them.
+
+    From the pydantic model's schema (:class:`Case`), with what the file format adds:
+
+    * ``extends``: a shipped case, a case file, or ``false`` / ``"none"`` for a complete case;
+    * every value (and table) of a section may be a ``{ value = ..., source = "..." }`` table
+      (keys ``value``, ``source``, ``note``, ``si``, ``origin``), as the shipped case writes them
+      and ``geardyn config show`` prints them; not inside the ``[[faults]]`` list;
+    * no key is required in a file that extends a base (a partial case: any key may come from
+      the base); a complete file (``extends = false`` or ``"none"``) must hold the sections and
+      keys the model requires; a ``[[faults]]`` entry is always complete (lists replace);
+    * quantities are a number in SI units or a string with a unit (``"5 mm"``), as the model's
+      schema says (``x-unit``, ``x-dimension``); the ``[provenance]`` table of dotted key =
+      source.
+
+    Not described: the checks of values against each other (model validators, e.g. the load
+    law's fields, ``centre_distance_max >= centre_distance_min``), the units a quantity string
+    may use, and pydantic's lax conversions (a number written as a string for a plain number).
+    """
+    model = Case.model_json_schema()
+    defs: dict[str, Any] = model.pop("$defs", {})
+    complete: dict[str, Any] = {}
+
+    def loosen(name: str, schema: dict[str, Any]) -> dict[str, Any]:
+        out = copy.deepcopy(schema)
+        if name in _LIST_ITEM_MODELS:
+            return out
+        required = out.pop("required", [])
+        props = out.get("properties", {})
+        skeleton: dict[str, Any] = {}
+        for key, sub in props.items():
+            refs = [r for r in _def_refs(sub) if r not in _LIST_ITEM_MODELS]
+            if refs:  # a section: in a complete file its own required keys apply
+                skeleton[key] = {"anyOf": [{"$ref": f"#/$defs/{refs[0]}.complete"},
+                                           {"not": {"$ref": f"#/$defs/{refs[0]}"}}]}
+            if key != "provenance":
+                props[key] = _sourced(sub)
+        complete[f"{name}.complete"] = {"required": required, "properties": skeleton} \
+            if required else {"properties": skeleton}
+        return out
+
+    file_defs = {name: loosen(name, d) for name, d in defs.items()}
+    root = loosen("Case", model)
+    root["properties"]["extends"] = _sourced({
+        "description": "The base case this file changes: a shipped case "
+                       f"({', '.join(shipped_cases())}) or a case file relative to this one "
+                       "(default: xue_howard); false or \"none\" for a complete case.",
+        "anyOf": [{"const": False}, {"type": "string", "pattern": "\\S"}],
+    })
+    root["allOf"] = [{
+        "if": {"properties": {"extends": {"enum": [False, "none"]}}, "required": ["extends"]},
+        "then": {"$ref": "#/$defs/Case.complete"},
+    }]
+    return {"$schema": "https://json-schema.org/draft/2020-12/schema", **root,
+            "$defs": {**file_defs, **complete}}
+
+
 def case_schema() -> str:
-    """JSON schema of case files (pretty-printed JSON text)."""
-    return json.dumps(Case.model_json_schema(), indent=2)
+    """JSON schema of case files (pretty-printed JSON text, :func:`case_file_schema`)."""
+    return json.dumps(case_file_schema(), indent=2)
 
 
 def deep_copy_case_data(case: Case) -> dict[str, Any]:

@@ -609,6 +609,18 @@ class GearPair:
              + math.sqrt(g.tip_radius ** 2 - g.base_radius ** 2) - self.base_pitch)
         return math.hypot(self.base_radius_sum, t) - self.design_centre_distance
 
+    def min_centre_distance_change(self) -> float:
+        """Smallest ``d' - d`` with a normal backlash >= 0 [m]: the change giving zero backlash.
+
+        ``j_n = 2 (r_b1 + r_b2)(inv alpha' - inv alpha_w) = 0`` solved for ``d'``; with the
+        design centre distance the zero-backlash one, this is 0 (up to rounding). Closer centres
+        would make the teeth interpenetrate. :meth:`operating` does not refuse them: stiffness
+        maps evaluate the mesh below the design centre distance on purpose (the default grid
+        starts at -0.5 mm); front ends that take a user's operating point check against this.
+        """
+        alpha0 = inv_inverse(float(inv(self.working_pressure_angle)))
+        return self.base_radius_sum / math.cos(alpha0) - self.design_centre_distance
+
     def contact_points(self, theta: float, centre_distance_change: float = 0.0,
                        *, margin: float = 1.0) -> ContactPoints:
         """Contact points of the pairs near the mesh at pinion angle ``theta``.

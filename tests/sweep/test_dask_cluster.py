@@ -48,8 +48,9 @@ def test_sweep_on_a_real_scheduler_and_two_workers(tmp_path):
         r = run_geardyn(["sweep", str(f), "--out", str(out), "--scheduler",
                          address], capture_output=True, text=True, env=env(), timeout=240,
                         cwd=tmp_path)
-    assert r.returncode == 0, r.stdout + r.stderr
+    assert r.returncode == 1, r.stdout + r.stderr  # 4 runs failed (recorded): exit status 1
     assert "ok 4, failed 4, pending 0" in r.stdout
+    assert "4 of 8 runs failed (their errors are in the store" in r.stderr
     ds = open_sweep(out).load()
     sw = load_sweep(f)
     plan = sw.plan()

@@ -62,9 +62,18 @@ for _name in ("stiffness", "simulate", "diagnose", "sweep", "measure", "static_t
     _optional(_name)
 
 
+def _literal_brackets(text: str) -> str:
+    """``text`` with every ``[`` escaped for rich markup (``[um]`` stays ``[um]``, not a style);
+    an already escaped ``\\[`` is left as it is."""
+    import re
+
+    return re.sub(r"(?<!\\)\[", r"\\[", text)
+
+
 def _tidy_help(command, ctx_settings: dict) -> None:
     """Walk the click command tree: flags without a ``<bool>`` type, arguments named in capitals,
-    square brackets in help texts shown literally (rich markup would eat ``[s]``), and ``-h``."""
+    square brackets in help texts (options' and commands' own) shown literally (rich markup would
+    eat ``[s]``), and ``-h``."""
     import inspect
 
     try:
@@ -81,10 +90,14 @@ def _tidy_help(command, ctx_settings: dict) -> None:
         elif getattr(p, "param_type_name", "") == "argument" and p.metavar is None:
             p.metavar = (p.name or "arg").upper()
         if getattr(p, "help", None):
-            p.help = p.help.replace("[", "\\[")
+            p.help = _literal_brackets(p.help)
     if getattr(command, "help", None):  # docstring line breaks are not paragraph breaks
-        command.help = "\n\n".join(" ".join(par.split())
-                                     for par in inspect.cleandoc(command.help).split("\n\n"))
+        command.help = _literal_brackets(
+            "\n\n".join(" ".join(par.split())
+                         for par in inspect.cleandoc(command.help).split("\n\n")))
+    for attr in ("short_help", "epilog"):
+        if getattr(command, attr, None):
+            setattr(command, attr, _literal_brackets(getattr(command, attr)))
     for sub in (getattr(command, "commands", None) or {}).values():
         _tidy_help(sub, ctx_settings)
 

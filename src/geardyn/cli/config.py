@@ -29,22 +29,42 @@ def show(config: ConfigOption = None, set_: SetOption = None) -> None:
 @handle_errors
 def validate(file: Annotated[Path, typer.Argument(help="Case file (TOML) to check.")],
              set_: SetOption = None) -> None:
-    """Check a case file with every check that needs no simulation (geometry, crack, FE mesh
-    size, load laws, run length): exit 0 and say so if it is valid, else name the problem
-    (exit 2)."""
-    from ..case_checks import check_case
-    from ..config import load_case
+    """Check a case file without simulating: exit 0 and say so if it is valid, else name the
+    problem (exit 2).
 
-    case = load_case(file, set_ or [])
-    check_case(case)
-    pair = case.gear_pair()
-    problems = pair.checks()
+    Runs every check that 'geardyn simulate' and 'geardyn measure' make before their first time
+    step, except FE computations, on the case as they run it by default (its simulation.model,
+    with its crack and faults): the geometry, crack, faults and FE mesh size; the load laws; the
+    run length; the model options; the time-step limit, static operating point and set-up of
+    the simulation on the case's stiffness map; the measurement chain and its sample rate.
+
+    Not checked: what only a simulation shows (divergence, the model II iteration, the centre
+    distance leaving the map). With stiffness.method = "fe" the checks that need the FE map run
+    only if the map is in the cache ('geardyn stiffness' builds it); otherwise the output names
+    them: the time-step limit from the map's largest mesh stiffness (the step is still checked
+    against the mesh frequency and the natural frequencies without mesh stiffness), the mesh
+    stiffness at the static operating point, the tooth modifications and the kernel set-up."""
     from rich.markup import escape
 
+    from ..case_checks import check_case
+    from ..config import load_case_details, with_written_value
+    from ..errors import InputError
+
+    details = load_case_details(file, set_ or [])
+    case = details.case
+    try:
+        notes = check_case(case)
+    except InputError as exc:
+        raise with_written_value(exc, details) from None
+    pair = case.gear_pair()
+    problems = pair.checks()
     console.print(f"[green]valid[/green]: {escape(str(file))} ({escape(case.name)}, {pair})",
                   highlight=False, soft_wrap=True)
     for p in problems:
         console.print(f"[yellow]warning[/yellow]: {p}", highlight=False, soft_wrap=True)
+    for note in notes:
+        console.print(f"[yellow]not checked[/yellow]: {escape(note)}", highlight=False,
+                      soft_wrap=True)
 
 
 @config_app.command("schema")

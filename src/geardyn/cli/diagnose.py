@@ -17,6 +17,14 @@ from ._common import (
     load_case_from_cli,
 )
 
+#: The command-line option of each argument of :func:`geardyn.diagnostics.diagnose_file` and
+#: its loaders, for their error messages.
+OPTION_NAMES = {
+    "signal": "--signal", "signals": "--signal", "teeth": "--teeth", "fs": "--fs",
+    "time": "--time", "angle": "--angle", "angle_unit": "--angle-unit", "tach": "--tach",
+    "tach_column_is_pulse_times": "--tach-times", "pulses_per_rev": "--pulses-per-rev",
+}
+
 
 @app.command("diagnose")
 @handle_errors
@@ -34,11 +42,16 @@ def diagnose(
                          "v_yg, omega_p, transmission_error.", show_default=False)] = None,
     teeth: Annotated[int | None, typer.Option(
         "--teeth", help="Teeth on the shaft whose angle is given (default: the simulation's "
-                        "pinion, or the case's pinion for measured data).",
+                        "pinion; for measured data the pinion of the case FILE stores, as a "
+                        "record of geardyn measure does (the gear if its tachometer reads the "
+                        "gear), else the pinion of the --config case).",
         show_default=False)] = None,
     fs: Annotated[str | None, typer.Option("--fs", help="Sampling rate of measured data: Hz, or "
                                                         "with a unit (Hz, kHz, MHz, 1/s), e.g. "
-                                                        "'20 kHz'.", show_default=False)] = None,
+                                                        "'20 kHz'. A file that stores its own "
+                                                        "rate (.nc, a .mat/.npz with fs) is "
+                                                        "read at that rate.", show_default=False
+                                       )] = None,
     time: Annotated[str | None, typer.Option("--time", help="Time column [s] (instead of --fs).",
                                              show_default=False)] = None,
     angle: Annotated[str | None, typer.Option("--angle", help="Shaft angle column.",
@@ -49,8 +62,10 @@ def diagnose(
                                              show_default=False)] = None,
     tach_times: Annotated[bool, typer.Option("--tach-times", help="The tach column holds pulse "
                                                                   "times [s].")] = False,
-    pulses_per_rev: Annotated[int, typer.Option("--pulses-per-rev", min=1,
-                                                help="Tachometer pulses per revolution.")] = 1,
+    pulses_per_rev: Annotated[int | None, typer.Option(
+        "--pulses-per-rev", min=1, help="Tachometer pulses per revolution (default: the count "
+                                        "the file states, as geardyn measure records it, else "
+                                        "1).", show_default=False)] = None,
     figures: Annotated[bool, typer.Option("--figures/--no-figures",
                                           help="Write the figures (PNG) as well as metrics.json."
                                           )] = True,
@@ -88,20 +103,21 @@ def diagnose(
     from ..diagnostics import diagnose_file
 
     d = case.diagnostics
-    is_sim = file.suffix.lower() in (".nc", ".nc4", ".netcdf")
-    if teeth is None and not is_sim:
-        teeth = case.pinion.teeth
+    # teeth: --teeth, else what FILE says (a simulation's pinion_teeth, the case a measured
+    # record stores), else for measured data the pinion of the --config case
     result = diagnose_file(
         file, teeth=teeth, signals=signal or None, fs=fs, time=time, angle=angle, tach=tach,
         tach_column_is_pulse_times=tach_times, pulses_per_rev=pulses_per_rev,
-        angle_unit=angle_unit, samples_per_rev=d.samples_per_rev, harmonic=d.harmonic,
-        bandwidth=d.bandwidth, residual_preset=d.residual_preset)
+        angle_unit=angle_unit, default_teeth=case.pinion.teeth, option_names=OPTION_NAMES,
+        samples_per_rev=d.samples_per_rev, harmonic=d.harmonic, bandwidth=d.bandwidth,
+        residual_preset=d.residual_preset)
     say_state(state, target)
     begin(target, ident)
     result.write(out, figures=figures)
     mark_complete(target, ident)
     summary = result.to_dict()
-    console.print(f"[green]done[/green]: metrics and figures in {out}/")
+    written = "metrics.json and figures" if figures else "metrics.json"
+    console.print(f"[green]done[/green]: {written} in {out}/ (teeth {result.teeth})")
     def num(v) -> str:
         return f"{v:.4g}" if isinstance(v, int | float) else "n/a"
 

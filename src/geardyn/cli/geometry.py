@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 from typing import Annotated
 
 import typer
@@ -19,24 +20,71 @@ def geometry(
     centre_distance_change: Annotated[
         str, typer.Option("--centre-distance-change", "-d",
                           help="Operating centre distance minus design, with a unit "
-                               "(e.g. 1.07mm) or in m.")] = "0 mm",
+                               "(e.g. 1.07mm) or in m; not below 0 (the design centre "
+                               "distance has zero backlash).")] = "0 mm",
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON (SI, unit in each key).")
                        ] = False,
 ) -> None:
     """Print the gear pair's geometry: radii, contact ratio, pressure angle, backlash, checks."""
-    from ..geometry import geometry_summary
     from ..units import to_si
 
     case = load_case_from_cli(config, set_)
     dd = to_si(centre_distance_change, "length", "--centre-distance-change")
     pair = case.gear_pair()
-    summary = geometry_summary(pair, dd)
+    summary = operating_summary(pair, dd)
     if as_json:
         typer.echo(json.dumps(summary, indent=2))
         return
     console.print(render_table(summary, f"{case.name}: {pair}"))
+    eps = summary["operating"]["contact_ratio"]["physical"]
+    if eps >= 2:
+        n = math.floor(eps)
+        console.print(f"note: contact ratio {eps:.4f} >= 2 (a high-contact-ratio pair): "
+                      f"{n} or {n + 1} tooth pairs share the load, never a single pair; the "
+                      f"fractions are of the mesh period with {n} and with {n + 1} pairs in "
+                      "contact", highlight=False)
     for w in summary["checks"]:
         console.print(f"[yellow]warning[/yellow]: {w}")
+
+
+class _Shown(str):
+    """A value for an error message, shown as written (with its unit, without quotes)."""
+
+    def __repr__(self) -> str:
+        return str(self)
+
+
+def operating_summary(pair, dd: float) -> dict:
+    """:func:`geardyn.geometry.geometry_summary` at a user's ``--centre-distance-change`` [m].
+
+    Refuses, naming the option and the value in mm, a change closer than the zero-backlash centre
+    distance (negative backlash: the teeth would interpenetrate) and one that drops the contact
+    ratio below 1. The check of negative backlash is made here, not in
+    :meth:`geardyn.geometry.GearPair.operating`: stiffness maps evaluate the mesh below the design
+    centre distance on purpose (the default ``[stiffness]`` grid starts at -0.5 mm).
+    """
+    from ..errors import GeometryError
+    from ..geometry import geometry_summary
+
+    option = "--centre-distance-change"
+    shown = _Shown(f"{dd * 1e3:.6g} mm")
+    lowest = pair.min_centre_distance_change()
+    if dd < lowest:
+        try:
+            jn = pair.operating(dd, check=False).normal_backlash
+            what = f"gives a normal backlash of {jn * 1e6:.2f} um"
+        except GeometryError:  # the centres closer than r_b1 + r_b2: no backlash is defined
+            what = "puts the centres closer than r_b1 + r_b2"
+        raise GeometryError(
+            option, shown,
+            f"a change >= {_fixed(lowest * 1e3, 4)} mm, the one giving zero backlash ({shown} "
+            f"{what}: the teeth would interpenetrate)")
+    try:
+        return geometry_summary(pair, dd)
+    except GeometryError as exc:
+        if exc.field != "centre_distance_change":
+            raise
+        raise GeometryError(option, shown, exc.allowed) from None
 
 
 def render_table(s: dict, title: str):
@@ -70,7 +118,7 @@ def render_table(s: dict, title: str):
         ("operating pressure angle [deg]", f"{op['pressure_angle_deg']:.4f}"),
         ("contact ratio, physical", f"{op['contact_ratio']['physical']:.4f}"),
         ("contact ratio, paper eq. 8", f"{op['contact_ratio']['paper_eq8']:.4f}"),
-        ("single / double contact fraction",
+        (_fraction_label(op['contact_ratio']['physical']),
          f"{op['single_contact_fraction']:.4f} / {op['double_contact_fraction']:.4f}"),
         ("contact interval on LOA from T1 [mm]",
          f"{op['contact_start_m'] * mm:.4f} .. {op['contact_end_m'] * mm:.4f}"),
@@ -82,6 +130,14 @@ def render_table(s: dict, title: str):
     for label, v in pair_rows:
         t.add_row(escape(label), v, "")
     return t
+
+
+def _fraction_label(eps: float) -> str:
+    """Label of the two contact fractions: of the lower and the higher number of pairs in mesh."""
+    n = math.floor(eps)
+    if n == 1:
+        return "single / double contact fraction"
+    return f"{n}-pair / {n + 1}-pair contact fraction"
 
 
 def _fixed(v: float, digits: int) -> str:

@@ -22,6 +22,9 @@ from ._common import (
     refuse_overwrite,
 )
 
+#: Default output file of ``geardyn measure``.
+DEFAULT_OUT = Path("measurement.nc")
+
 
 @app.command("measure")
 @handle_errors
@@ -36,8 +39,9 @@ def measure(
                                         help="Include the case's crack and faults (--no-crack: "
                                              "the healthy pair, also without wear's gap).")
                      ] = True,
-    out: Annotated[Path, typer.Option("--out", "-o", help="Output NetCDF file.")
-                   ] = Path("measurement.nc"),
+    out: Annotated[Path | None, typer.Option(
+        "--out", "-o", help=f"Output NetCDF file (default: {DEFAULT_OUT}).", show_default=False)
+                   ] = None,
     csv: Annotated[bool, typer.Option("--csv", help="Also write a CSV file beside it.")] = False,
     mat: Annotated[bool, typer.Option("--mat", help="Also write a MATLAB .mat file beside it.")
                    ] = False,
@@ -51,11 +55,19 @@ def measure(
     the record (case.simulation.record_time long) to OUT."""
     from typing import get_args
 
+    from ._outputs import check_writable, resolve
+
+    target = resolve(out, DEFAULT_OUT)
+    out = target.path
+    # before loading anything heavy: an unwritable --out (or one below a file, or a folder)
+    # fails at once, not after the simulation
+    check_writable(target, folder=False)
+
+    from ..case_checks import check_measurement
     from ..config import SimulationConfig
     from ..errors import InputError
     from ..measurement.record import write_csv, write_mat, write_netcdf
     from ..stiffness import build_map
-    from ..studies.measure import chain_from_config
     from ..studies.measure import measure as run_measure
 
     models = get_args(SimulationConfig.model_fields["model"].annotation)  # "I", "I-static", "II"
@@ -68,12 +80,10 @@ def measure(
     which = case.simulation.model if model is None else model
     if stiffness is not None and stiffness not in ("pem", "fe"):
         raise InputError("--stiffness", stiffness, "'pem' or 'fe'")
-    if out.exists() and out.is_dir():
-        raise InputError("--out", str(out), "a file path (it is a folder)")
     targets = [out] + ([out.with_suffix(".csv")] if csv else []) \
         + ([out.with_suffix(".mat")] if mat else [])
     refuse_overwrite(targets, force)
-    chain_from_config(case.measurement)  # bad chain settings fail before the simulation
+    check_measurement(case)  # bad chain settings and sample rate fail before the simulation
     with progress_bar() as bar:
         task = bar.add_task("stiffness map", total=None)
 

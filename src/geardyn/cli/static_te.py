@@ -48,9 +48,9 @@ def static_te(
     points: Annotated[int, typer.Option(
         "--points", "-n", help="Pinion angles over one hunting period (the tooth pairing's "
                                "repeat).")] = 4096,
-    out: Annotated[Path, typer.Option("--out", "-o", help="Output NetCDF file; the figure is "
-                                                          "written beside it (.png).")
-                   ] = DEFAULT_OUT,
+    out: Annotated[Path | None, typer.Option(
+        "--out", "-o", help=f"Output NetCDF file (default: {DEFAULT_OUT}); the figure is written "
+                            "beside it (.png).", show_default=False)] = None,
     force: ForceOption = False,
 ) -> None:
     """Static transmission error of the pair, unloaded (T = 0) and loaded, along the line of
@@ -60,12 +60,15 @@ def static_te(
 
     from ..errors import InputError
     from ..units import to_si
+    from ._outputs import check_writable, resolve
 
     method = choice("--stiffness", stiffness, ("pem", "fe"))
     if not 16 <= points <= 1_000_000:
         raise InputError("--points", points, "an integer from 16 to 1000000")
-    if out.exists() and out.is_dir():
-        raise InputError("--out", str(out), "a file path (it is a folder)")
+    target = resolve(out, DEFAULT_OUT)
+    out = target.path
+    # an unwritable --out (or one below a file, or a folder) fails here, not after the map
+    check_writable(target, folder=False)
     png = out.with_suffix(".png")
     refuse_overwrite([out, png], force)
     case = load_case_from_cli(config, set_)

@@ -69,6 +69,7 @@ def model_ii(
     from ..io import write_netcdf_atomic
     from ..studies.model_regimes import model_regimes
     from ..studies.model_regimes_report import regime_summary, write_report
+    from ._outputs import OutputTarget, check_writable
 
     require_extra("sweep")  # dask, distributed, zarr: a clear error naming the extra
     if method is not None and method not in ("pem", "fe"):
@@ -77,8 +78,8 @@ def model_ii(
         raise InputError("--workers", workers, "a positive number of worker processes")
     if quick and sweep_file is not None:
         raise InputError("--quick", True, "either --quick or --sweep, not both")
-    if out.exists() and not out.is_dir():
-        raise InputError("--out", str(out), "a folder (it is a file)")
+    # a file, a path below a file or an unwritable folder fails here, before the sweep starts
+    check_writable(OutputTarget(out, given=True), folder=True)
     case = load_case(config) if config is not None else None
     command = "geardyn " + " ".join(shlex.quote(a) for a in sys.argv[1:])
     out.mkdir(parents=True, exist_ok=True)

@@ -118,7 +118,9 @@ def sweep(
     set_: SetOption = None,
 ) -> None:
     """Run the sweep in SWEEP_FILE on Dask into the Zarr store OUT (resumable: re-run the same
-    command after an interruption to compute only the missing runs)."""
+    command after an interruption to compute only the missing runs). Exit status 1 if any run
+    of the store failed (their errors are in its 'error' variable) or is still pending, after
+    the store and the summary are written; 0 if every run is ok."""
     from .._optional import require_extra
     from ..errors import InputError
 
@@ -135,6 +137,10 @@ def sweep(
         raise InputError("SWEEP_FILE", None, "a sweep file (TOML), or --verify STORE")
     if out is None:
         raise InputError("--out", None, "the Zarr store to create or resume (a folder)")
+    if not out.exists() or out.is_dir():  # an existing file: "not a Zarr store", below
+        from ._outputs import OutputTarget, check_writable
+
+        check_writable(OutputTarget(out, given=True), folder=True)  # before any work
     sw = with_base_case(load_sweep(sweep_file, max_runs=max_runs), config, set_ or [])
     ev = _load_evaluator(evaluator) if evaluator else None
     with progress_bar() as bar:
@@ -175,4 +181,11 @@ def sweep(
             err_console.print(f"  [red]task lost[/red]: {t}", highlight=False, soft_wrap=True)
         err_console.print(f"[red]{result.pending} run(s) still pending[/red]: re-run the same "
                           "command to compute them")
+    if result.failed:  # the last line: a script sees the failures in the exit status too
+        from rich.markup import escape
+
+        err_console.print(f"[red]{result.failed} of {result.n_runs} runs failed[/red] (their "
+                          f"errors are in the store: {escape(str(result.out))}, variable "
+                          "'error')", highlight=False, soft_wrap=True)
+    if result.failed or result.pending:
         raise typer.Exit(1)

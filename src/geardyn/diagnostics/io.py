@@ -57,12 +57,17 @@ class DataTable:
     columns : dict of str to ndarray
         Channel name -> 1-D float64 array (file unit), in file order.
     scalars : dict of str to float
-        Scalar numeric entries of ``.npz``/``.mat`` files (e.g. a stored ``fs``).
+        Scalar numeric entries of ``.npz``/``.mat``/NetCDF files (e.g. a stored ``fs``).
+    text : dict of str to str
+        Text entries of ``.mat`` files (``char`` variables and struct fields, dotted like the
+        channels) and NetCDF files (global attributes), e.g. the ``case_toml`` a record of
+        ``geardyn measure`` carries.
     """
 
     path: str
     columns: dict[str, np.ndarray]
     scalars: dict[str, float] = field(default_factory=dict)
+    text: dict[str, str] = field(default_factory=dict)
 
     @property
     def names(self) -> list[str]:
@@ -283,16 +288,17 @@ def _read_mat(p: Path) -> DataTable:
                                        f"{exc})") from exc
     cols: dict[str, np.ndarray] = {}
     scalars: dict[str, float] = {}
+    text: dict[str, str] = {}
     for name, value in content.items():
         if not name.startswith("__"):
-            _mat_variable(name, value, cols, scalars)
+            _mat_variable(name, value, cols, scalars, text)
     if not cols:
         why = f"; the reader said: {str(caught[0].message)[:200]}" if caught else ""
         raise DataFileError(p, "no numeric vector or matrix variables (text, empty arrays, "
                                f"cells and objects are not signals){why}")
     for w in caught:
         warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
-    return DataTable(str(p), cols, scalars)
+    return DataTable(str(p), cols, scalars, text)
 
 
 def _load_mat73(p: Path) -> dict:
@@ -326,11 +332,15 @@ def _load_mat73(p: Path) -> dict:
     return content
 
 
-def _mat_variable(name: str, value, cols: dict, scalars: dict) -> None:
-    """Add a MATLAB variable: numeric arrays as channels/scalars, struct fields recursively."""
+def _mat_variable(name: str, value, cols: dict, scalars: dict, text: dict | None = None) -> None:
+    """Add a MATLAB variable: numeric arrays as channels/scalars, struct fields recursively,
+    text (``char``) to ``text``."""
     if isinstance(value, dict):  # struct (scipy simplify_cells, mat73): fields as a.b
         for key, field_value in value.items():
-            _mat_variable(f"{name}.{key}", field_value, cols, scalars)
+            _mat_variable(f"{name}.{key}", field_value, cols, scalars, text)
+        return
+    if isinstance(value, str) and text is not None:
+        text[name] = value  # char: not a signal, but e.g. a record's case_toml
         return
     if value is None or isinstance(value, (str, bytes, list, tuple)):
         return  # empty (mat73), char, cell array: not signals
@@ -342,7 +352,8 @@ def _mat_variable(name: str, value, cols: dict, scalars: dict) -> None:
 
 def _read_netcdf_table(p: Path) -> DataTable:
     """A NetCDF file as measured data: every 1-D numeric variable (coordinates included, e.g.
-    ``time``) is a channel; numeric global attributes (e.g. ``fs``) are scalars."""
+    ``time``) is a channel; numeric global attributes (e.g. ``fs``) are scalars, text ones
+    (e.g. ``case_toml``) text."""
     try:
         import xarray as xr
 
@@ -352,6 +363,7 @@ def _read_netcdf_table(p: Path) -> DataTable:
                                f"{exc})") from exc
     cols: dict[str, np.ndarray] = {}
     scalars: dict[str, float] = {}
+    text: dict[str, str] = {}
     try:
         for name, var in {**dict(ds.coords), **dict(ds.data_vars)}.items():
             if var.ndim == 1 and var.dtype.kind in "biuf":
@@ -359,15 +371,18 @@ def _read_netcdf_table(p: Path) -> DataTable:
         for k, v in ds.attrs.items():
             if isinstance(v, int | float | np.integer | np.floating) and not isinstance(v, bool):
                 scalars[str(k)] = float(v)
+            elif isinstance(v, str):
+                text[str(k)] = v
     finally:
         ds.close()
     if not cols:
         raise DataFileError(p, "no numeric 1-D variables")
-    return DataTable(str(p), cols, scalars)
+    return DataTable(str(p), cols, scalars, text)
 
 
 # --------------------------------------------------------------------------------------------
-def read_simulation(path, variables) -> tuple[np.ndarray, dict[str, np.ndarray], dict]:
+def read_simulation(path, variables, *,
+                    field_name: str = "signals") -> tuple[np.ndarray, dict[str, np.ndarray], dict]:
     """Read a geardyn simulation result (NetCDF4/HDF5 written by xarray with h5netcdf).
 
     Parameters
@@ -377,6 +392,8 @@ def read_simulation(path, variables) -> tuple[np.ndarray, dict[str, np.ndarray],
     variables : sequence of str
         Data variables to read (e.g. ``theta_p`` [rad], ``v_yg`` [m/s], ``omega_p`` [rad/s],
         ``transmission_error`` [rad]).
+    field_name : str
+        Argument name used in the message about an absent variable.
 
     Returns
     -------
@@ -417,7 +434,7 @@ def read_simulation(path, variables) -> tuple[np.ndarray, dict[str, np.ndarray],
         missing = [v for v in variables if v not in ds.data_vars]
         if missing:
             have = ", ".join(sorted(map(str, ds.data_vars)))
-            raise InputError("signals", missing[0] if len(missing) == 1 else missing,
+            raise InputError(field_name, missing[0] if len(missing) == 1 else missing,
                              f"data variables of {p.name}: {have}")
         try:
             time = np.asarray(ds["time"].values, dtype=np.float64)

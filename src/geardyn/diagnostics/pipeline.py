@@ -27,8 +27,9 @@ tooth-mesh events of a 23-tooth pinion with about 89 samples per tooth), 5th mes
 from __future__ import annotations
 
 import json
+import math
 import os
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -48,7 +49,7 @@ from .metrics import (
 )
 from .spectra import OrderSpectrum, difference, order_spectrum, regular, residual
 from .tfd import PWVDResult, pwvd
-from .tsa import TSAResult, _check_int, tach_pulse_times, tsa
+from .tsa import ShortRecordError, TSAResult, _check_int, tach_pulse_times, tsa
 
 __all__ = [
     "SIMULATION_SIGNALS",
@@ -111,12 +112,14 @@ class Measurement:
 # loading
 # --------------------------------------------------------------------------------------------
 def load_simulation(path, *, signals: Sequence[str] | None = None,
-                    angle: str = "theta_p") -> Measurement:
+                    angle: str = "theta_p",
+                    option_names: Mapping[str, str] | None = None) -> Measurement:
     """Read a geardyn simulation result (NetCDF) for diagnosis.
 
     The shaft angle is the exact pinion angle ``theta_p`` [rad]; the default signals are the
     paper's three: ``v_yg`` [m/s], ``omega_p`` [rad/s] and ``transmission_error`` [rad]. The
-    tooth count for the mesh orders is the attribute ``pinion_teeth``.
+    tooth count for the mesh orders is the attribute ``pinion_teeth`` (else the pinion of the
+    case stored in the attribute ``case_toml``).
 
     Parameters
     ----------
@@ -126,6 +129,9 @@ def load_simulation(path, *, signals: Sequence[str] | None = None,
         Data variables to diagnose; default :data:`SIMULATION_SIGNALS`.
     angle : str
         Data variable holding the shaft angle [rad].
+    option_names : mapping, optional
+        Names to give the arguments in error messages (e.g. ``{"signals": "--signal"}`` for a
+        command line); default the argument names.
 
     Returns
     -------
@@ -138,15 +144,32 @@ def load_simulation(path, *, signals: Sequence[str] | None = None,
     InputError
         A requested variable is absent.
     """
+    name_of = _namer(option_names)
     names = list(signals) if signals is not None else list(SIMULATION_SIGNALS)
     if not names:
-        raise InputError("signals", names, "at least one data variable name")
-    time, data, attrs = read_simulation(path, [angle, *[n for n in names if n != angle]])
-    teeth = attrs.get("pinion_teeth")
+        raise InputError(name_of("signals"), names, "at least one data variable name")
     try:
-        teeth = None if teeth is None else int(np.asarray(teeth).reshape(-1)[0])
-    except (TypeError, ValueError):
-        teeth = None
+        time, data, attrs = read_simulation(path, [angle, *[n for n in names if n != angle]],
+                                            field_name=name_of("signals"))
+    except InputError as exc:
+        missing = exc.value if isinstance(exc.value, list) else [exc.value]
+        if angle not in missing:
+            raise
+        # not a simulation result (e.g. a measured record in NetCDF): not a --signal problem
+        raise DataFileError(path, f"has no {angle!r}, the shaft angle of a geardyn simulation "
+                                  "result: for measured data name its shaft angle or "
+                                  f"tachometer channel ({name_of('angle')} or "
+                                  f"{name_of('tach')})") from None
+    scalars, text = {}, {}
+    for k, v in attrs.items():
+        if isinstance(v, str):
+            text[str(k)] = v
+        else:
+            try:
+                scalars[str(k)] = float(np.asarray(v).reshape(-1)[0])
+            except (TypeError, ValueError, IndexError):
+                pass
+    teeth = _stored_teeth(scalars, text, "pinion")
     units = {n: attrs["units"].get(n) or SIMULATION_SIGNALS.get(n, "") for n in names}
     return Measurement(signals={n: data[n] for n in names}, time=time, angle=data[angle],
                        teeth=teeth, units=units, source=str(path))
@@ -161,11 +184,12 @@ def load_measurement(
     angle: str | int | None = None,
     tach: str | int | None = None,
     tach_column_is_pulse_times: bool = False,
-    pulses_per_rev: int = 1,
+    pulses_per_rev: int | None = None,
     tach_threshold: float | None = None,
     angle_unit: str = "rad",
     unwrap_angle: bool = False,
     units: Mapping[str, str] | None = None,
+    option_names: Mapping[str, str] | None = None,
 ) -> Measurement:
     """Read measured data (CSV/text, .npy, .npz, .mat) for diagnosis.
 
@@ -178,6 +202,13 @@ def load_measurement(
     averaged (e.g. 1 for a once-per-rev key phasor, 60 for a 60-tooth wheel); pulses are assumed
     equally spaced around the shaft.
 
+    A file that stores its own sample rate (a scalar ``fs`` in a .npz/.mat file, a global
+    attribute ``fs`` of a NetCDF file) is read at that rate: an ``fs`` that differs from it is
+    refused. The teeth on the averaged shaft are taken from the file when it says
+    (:attr:`Measurement.teeth`): a ``pinion_teeth`` entry, or the pinion of the case a
+    ``geardyn measure`` record stores (``case_toml``; the gear when the record's tachometer
+    reads the gear shaft, ``tach_shaft = "gear"``, and ``tach`` is given).
+
     Parameters
     ----------
     path : str or path-like
@@ -185,7 +216,8 @@ def load_measurement(
     signal : str, int or sequence of them
         Column(s) to diagnose (name or 0-based position).
     fs : float, optional
-        Sample rate [Hz]; if absent, a scalar ``fs`` stored in a .npz/.mat file is used.
+        Sample rate [Hz]; if absent, a scalar ``fs`` stored in the file is used. Not with
+        ``time``; for a file that stores its rate, only that rate.
     time : str or int, optional
         Column of sample times [s].
     angle : str or int, optional
@@ -194,8 +226,10 @@ def load_measurement(
         Tachometer column.
     tach_column_is_pulse_times : bool
         The ``tach`` column lists pulse times [s] instead of a sampled pulse train.
-    pulses_per_rev : int
-        Tachometer pulses per shaft revolution [-].
+    pulses_per_rev : int, optional
+        Tachometer pulses per shaft revolution [-]; default what the file says
+        (``tach_pulses_per_rev``, as ``geardyn measure`` writes it), else 1. A value that
+        contradicts the file's is refused.
     tach_threshold : float, optional
         Edge threshold of a sampled pulse train (unit of the column).
     angle_unit : {"rad", "deg", "rev"}
@@ -204,6 +238,9 @@ def load_measurement(
         Unwrap a wrapped angle column (0..2*pi sawtooth).
     units : mapping, optional
         Unit of each signal, for labels (name -> unit).
+    option_names : mapping, optional
+        Names to give the arguments in error messages, e.g. ``{"fs": "--fs", "time":
+        "--time"}`` for a command line; default the argument names.
 
     Returns
     -------
@@ -212,66 +249,158 @@ def load_measurement(
     Raises
     ------
     DataFileError
-        Unreadable/corrupt/truncated file.
+        Unreadable/corrupt/truncated file, a stored sample rate that is not a positive number.
     InputError
-        Missing column, no sampling or angle information, bad options.
+        Missing column, no sampling or angle information, ``fs`` with ``time``, an ``fs`` other
+        than the file's own, bad options.
     """
+    name_of = _namer(option_names)
     table = read_table(path)
+    file_name = Path(path).name
     specs = [signal] if isinstance(signal, (str, int, np.integer)) else list(signal)
     if not specs:
-        raise InputError("signal", signal, "at least one column")
+        raise InputError(name_of("signal"), signal, "at least one column")
     signals: dict[str, np.ndarray] = {}
     for s in specs:
-        arr = table.get(s, "signal")
+        arr = table.get(s, name_of("signal"))
         name = s if isinstance(s, str) and s in table.columns else table.names[int(s)]
         signals[name] = arr
     n = next(iter(signals.values())).shape[0]
 
-    if fs is None and time is None and "fs" in table.scalars:
-        fs = table.scalars["fs"]
-    t = None if time is None else table.get(time, "time")
-    if fs is None and t is None:
-        raise InputError("fs", None, "a sample rate in Hz, or a time column (time=)")
+    fs_, time_ = name_of("fs"), name_of("time")
     if fs is not None and not (np.isfinite(fs) and fs > 0):
-        raise InputError("fs", fs, "a positive sample rate in Hz")
+        raise InputError(fs_, fs, "a positive sample rate in Hz")
+    if fs is not None and time is not None:
+        # the time column would win (tach edges, tsa) and fs be ignored without a word
+        raise InputError(fs_, f"{fs:.10g} Hz",
+                         f"no {fs_} together with {time_} (the times of column {time!r} "
+                         f"would be used): give one of them")
+    stored_fs = table.scalars.get("fs")
+    if stored_fs is not None and np.isfinite(stored_fs) and stored_fs > 0:
+        if fs is not None and not _same_rate(fs, stored_fs):
+            raise InputError(fs_, f"{fs:.10g} Hz",
+                             f"{file_name}'s own sample rate, {stored_fs:.10g} Hz, or no "
+                             f"{fs_}: the file stores its rate")
+        if time is None:
+            fs = stored_fs
+    elif stored_fs is not None and fs is None and time is None:
+        raise DataFileError(path, f"stores a sample rate fs = {stored_fs:g}, not a positive "
+                                  f"number of Hz: give the rate ({fs_}) or a time column "
+                                  f"({time_})")
+    t = None if time is None else table.get(time, time_)
+    if fs is None and t is None:
+        raise InputError(f"{fs_}/{time_}", "neither",
+                         f"a sample rate in Hz ({fs_}) or a time column ({time_}): "
+                         f"{file_name} stores no sample rate")
 
     if (angle is None) == (tach is None):
-        raise InputError("angle/tach", "both" if angle is not None else "neither",
+        raise InputError(f"{name_of('angle')}/{name_of('tach')}",
+                         "both" if angle is not None else "neither",
                          "exactly one of an angle column or a tachometer column")
     ang = None
     tach_times = None
     if angle is not None:
         scale = {"rad": 1.0, "deg": np.pi / 180.0, "rev": 2.0 * np.pi}.get(angle_unit)
         if scale is None:
-            raise InputError("angle_unit", angle_unit, "'rad', 'deg' or 'rev'")
-        ang = table.get(angle, "angle") * scale
+            raise InputError(name_of("angle_unit"), angle_unit, "'rad', 'deg' or 'rev'")
+        ang = table.get(angle, name_of("angle")) * scale
         if unwrap_angle:
             ang = np.unwrap(ang)
     else:
-        col = table.get(tach, "tach")
+        col = table.get(tach, name_of("tach"))
         if not tach_column_is_pulse_times and col.shape[0] != n:
             # before any edge search: a length mismatch is not a threshold problem
             first = next(iter(signals))
-            raise InputError("tach", f"channel {tach!r} has {col.shape[0]} samples",
+            raise InputError(name_of("tach"), f"channel {tach!r} has {col.shape[0]} samples",
                              f"a sampled pulse train as long as the signal {first!r} "
                              f"({n} samples), or a column of pulse times "
-                             "(tach_column_is_pulse_times, --tach-times)")
+                             f"({name_of('tach_column_is_pulse_times')})")
         if tach_column_is_pulse_times:
             tach_times = col[np.isfinite(col)]
         else:
             tach_times = tach_pulse_times(col, fs=None if t is not None else fs, time=t,
                                           threshold=tach_threshold)
         if tach_times.size < 2:
-            raise InputError("tach", tach, "a tachometer channel with at least 2 pulses "
-                                           f"(found {tach_times.size})")
-    for name, arr in [*signals.items(), ("time", t), ("angle", ang)]:
+            raise InputError(name_of("tach"), tach, "a tachometer channel with at least 2 "
+                                                    f"pulses (found {tach_times.size})")
+    for name, arr in [*signals.items(), (time_, t), (name_of("angle"), ang)]:
         if arr is not None and arr.shape[0] != n:
             raise InputError(name, f"{arr.shape[0]} samples", f"{n} samples like the signal")
+    shaft = "pinion"
+    if tach is not None and _entry(table.text, "tach_shaft", "").strip() == "gear":
+        shaft = "gear"  # a geardyn measure record whose tachometer reads the gear shaft
+    ppr = _pulses_per_rev(path, table.scalars, pulses_per_rev, name_of)
     return Measurement(signals=signals, fs=None if fs is None else float(fs), time=t,
-                       angle=ang, tach_times=tach_times,
-                       pulses_per_rev=_check_int(pulses_per_rev, "pulses_per_rev", 1),
+                       angle=ang, tach_times=tach_times, pulses_per_rev=ppr,
+                       teeth=_stored_teeth(table.scalars, table.text, shaft),
                        units={k: (units or {}).get(k, "") for k in signals},
                        source=str(path))
+
+
+def _namer(option_names: Mapping[str, str] | None) -> Callable[[str], str]:
+    """``name_of(argument)``: the name an error message gives an argument (its own by
+    default, e.g. the command-line option when the CLI passes ``option_names``)."""
+    names = dict(option_names or {})
+    return lambda key: names.get(key, key)
+
+
+def _same_rate(a: float, b: float) -> bool:
+    """Two sample rates [Hz] equal up to rounding (a rate typed as "51.2 kHz", one computed
+    from a time axis)."""
+    return math.isclose(float(a), float(b), rel_tol=1e-9)
+
+
+def _entry(entries: Mapping[str, Any], key: str, default=None):
+    """``key`` of a file's entries, at the top or in an ``attrs`` struct (``.mat`` records of
+    ``geardyn measure`` keep their attributes there)."""
+    return entries.get(key, entries.get(f"attrs.{key}", default))
+
+
+def _pulses_per_rev(path, scalars: Mapping[str, float], given: int | None,
+                    name_of: Callable[[str], str]) -> int:
+    """Tachometer pulses per revolution: ``given``, else the file's ``tach_pulses_per_rev``,
+    else 1. A ``given`` value that contradicts the file's is refused (a wrong count scales
+    every order of the TSA: nothing to diagnose with it)."""
+    stored = _entry(scalars, "tach_pulses_per_rev")
+    ok = (stored is not None and not isinstance(stored, bool) and np.isfinite(stored)
+          and stored >= 1 and float(stored) == int(stored))
+    if given is None:
+        return int(stored) if ok else 1
+    value = _check_int(given, name_of("pulses_per_rev"), 1)
+    if ok and value != int(stored):
+        raise InputError(name_of("pulses_per_rev"), value,
+                         f"{Path(path).name}'s own count, {int(stored)} (its tach_pulses_per_"
+                         f"rev), or no {name_of('pulses_per_rev')}: the file states it")
+    return value
+
+
+def _stored_teeth(scalars: Mapping[str, float], text: Mapping[str, str],
+                  shaft: str) -> int | None:
+    """Teeth of the ``shaft`` ("pinion" or "gear") as a file says: a ``<shaft>_teeth`` entry,
+    else ``<shaft>.teeth`` of the case TOML it stores (``case_toml``); None if it says neither
+    (or says it in a form that is not a positive whole number)."""
+    def whole(v) -> int | None:
+        if isinstance(v, bool) or not isinstance(v, int | float | np.integer | np.floating):
+            return None
+        return int(v) if np.isfinite(v) and v >= 1 and float(v) == int(v) else None
+
+    value = _entry(scalars, f"{shaft}_teeth")
+    if value is not None:
+        return whole(value)
+    toml = _entry(text, "case_toml")
+    if not toml:
+        return None
+    from ..config import parse_case_toml
+    from ..errors import GeardynError
+
+    try:
+        raw = parse_case_toml(toml, "case_toml")
+    except GeardynError:
+        return None
+    teeth = raw.get(shaft, {}).get("teeth") if isinstance(raw.get(shaft), dict) else None
+    if isinstance(teeth, dict):  # { value = 23, source = "..." }
+        teeth = teeth.get("value")
+    return whole(teeth)
 
 
 def load(path, **kwargs) -> Measurement:
@@ -689,18 +818,22 @@ def diagnose_file(
     angle: str | int | None = None,
     tach: str | int | None = None,
     tach_column_is_pulse_times: bool = False,
-    pulses_per_rev: int = 1,
+    pulses_per_rev: int | None = None,
     tach_threshold: float | None = None,
     angle_unit: str = "rad",
     unwrap_angle: bool = False,
+    default_teeth: int | None = None,
+    option_names: Mapping[str, str] | None = None,
     **options,
 ) -> DiagnosisResult:
     """Load a file (simulation NetCDF or measured data) and run :func:`diagnose` on it.
 
     For a simulation result only ``signals`` (data variable names; default the paper's three)
-    and ``teeth`` (default the ``pinion_teeth`` attribute) are used, the angle is ``theta_p``.
-    For measured data ``signals`` are column names/positions and ``teeth`` is required; see
-    :func:`load_measurement` for the sampling and angle arguments.
+    and ``teeth`` (default the ``pinion_teeth`` attribute) are used, the angle is ``theta_p``;
+    it has its own time axis, so ``fs`` (other than its own rate) and ``time`` (other than
+    ``"time"``) are refused. For measured data ``signals`` are column names/positions and
+    ``teeth`` defaults to what the file says (:func:`load_measurement`), else
+    ``default_teeth``; see :func:`load_measurement` for the sampling and angle arguments.
 
     Parameters
     ----------
@@ -713,6 +846,12 @@ def diagnose_file(
     fs, time, angle, tach, tach_column_is_pulse_times, pulses_per_rev, tach_threshold,
     angle_unit, unwrap_angle
         See :func:`load_measurement`.
+    default_teeth : int, optional
+        Z [-] for measured data whose file does not say it (the command line passes its case's
+        pinion); a simulation result must say it.
+    option_names : mapping, optional
+        Names to give the arguments in error messages (argument -> name, e.g. ``{"fs":
+        "--fs"}``); default the argument names.
     **options
         Passed to :func:`diagnose` (``samples_per_rev``, ``harmonic``, ``bandwidth``,
         ``residual_preset``, ...).
@@ -720,25 +859,96 @@ def diagnose_file(
     Returns
     -------
     DiagnosisResult
+
+    Raises
+    ------
+    DataFileError
+        Besides the file problems of the loaders: a record too short to hold one whole
+        revolution of the averaged shaft.
+    InputError
+        See :func:`load_simulation`, :func:`load_measurement` and :func:`diagnose`.
     """
+    name_of = _namer(option_names)
+    if teeth is not None:
+        _check_int(teeth, name_of("teeth"), 1, "a positive integer number of teeth")
     # a NetCDF file is read as a geardyn simulation (exact angle theta_p) unless the shaft angle
     # is given as for measured data (a tach or angle channel): then any NetCDF file of 1-D
     # channels (e.g. written by geardyn measure or a DAQ) reads like a CSV, fs from its attribute
-    if Path(path).suffix.lower() in NETCDF_SUFFIXES and tach is None and angle is None:
+    simulation = (Path(path).suffix.lower() in NETCDF_SUFFIXES and tach is None
+                  and angle is None)
+    if simulation:
         sig = None if signals is None else ([signals] if isinstance(signals, str)
                                             else [str(s) for s in signals])
-        m = load_simulation(path, signals=sig)
+        m = load_simulation(path, signals=sig, option_names=option_names)
+        _check_own_time_axis(path, m.time, fs, time, name_of)
     else:
         if signals is None:
-            raise InputError("signals", None, "the column(s) to diagnose (name or position)")
+            raise InputError(name_of("signals"), None,
+                             "the column(s) to diagnose (name or position)")
         m = load_measurement(path, signal=signals, fs=fs, time=time, angle=angle, tach=tach,
                              tach_column_is_pulse_times=tach_column_is_pulse_times,
                              pulses_per_rev=pulses_per_rev, tach_threshold=tach_threshold,
-                             angle_unit=angle_unit, unwrap_angle=unwrap_angle)
+                             angle_unit=angle_unit, unwrap_angle=unwrap_angle,
+                             option_names=option_names)
     z = teeth if teeth is not None else m.teeth
+    if z is None and not simulation:
+        z = default_teeth
     if z is None:
-        raise InputError("teeth", None, "the number of teeth of the gear on the averaged shaft "
-                                        "(not stored in this file)")
-    return diagnose(m.signals, teeth=z, fs=m.fs, time=m.time, angle=m.angle,
-                    tach_times=m.tach_times, pulses_per_rev=m.pulses_per_rev,
-                    units=m.units, source=str(path), **options)
+        raise InputError(name_of("teeth"), None,
+                         "the number of teeth of the gear on the averaged shaft ("
+                         f"{Path(path).name} stores neither it nor the case it was made with)")
+    try:
+        return diagnose(m.signals, teeth=z, fs=m.fs, time=m.time, angle=m.angle,
+                        tach_times=m.tach_times, pulses_per_rev=m.pulses_per_rev,
+                        units=m.units, source=str(path), **options)
+    except ShortRecordError as exc:
+        raise _short_record(path, m, exc, simulation) from None
+
+
+def _check_own_time_axis(path, time_axis: np.ndarray, fs, time, name_of) -> None:
+    """A simulation result samples on its own ``time`` axis: refuse an ``fs`` (other than its
+    own rate) or a ``time`` column (other than ``"time"``) instead of ignoring them."""
+    file_name = Path(path).name
+    if fs is not None:
+        steps = np.diff(time_axis)
+        rate = 1.0 / float(np.median(steps)) if steps.size and np.median(steps) > 0 else None
+        if rate is None or not _same_rate(fs, rate):
+            own = f"{rate:.10g} Hz" if rate is not None else "its time axis"
+            raise InputError(name_of("fs"), f"{fs:.10g} Hz",
+                             f"no {name_of('fs')} for a geardyn simulation result: "
+                             f"{file_name} has its own time axis ({own})")
+    if time is not None and str(time) != "time":
+        raise InputError(name_of("time"), time,
+                         f"no {name_of('time')} for a geardyn simulation result: {file_name} "
+                         "has its own time axis ('time')")
+
+
+def _short_record(path, m: Measurement, exc: ShortRecordError,
+                  simulation: bool) -> DataFileError:
+    """The TSA's "no whole revolution" in the terms of the file: how many revolutions the
+    record spans, what is needed and, when the speed is known, how long a record would do."""
+    revs, skip = exc.revolutions, exc.skip
+    need = skip + 2  # any record of skip + 2 revolutions holds a whole one after the skip
+    seconds = per_rev = None
+    if m.time is not None and m.time.size > 1:
+        seconds = float(m.time[-1] - m.time[0])
+    elif m.fs:
+        seconds = (next(iter(m.signals.values())).shape[0] - 1) / m.fs
+    if m.tach_times is not None and m.tach_times.size > 1:
+        tt = m.tach_times
+        per_rev = float(tt[-1] - tt[0]) * m.pulses_per_rev / (tt.size - 1)
+    elif seconds is not None and revs > 0:
+        per_rev = seconds / revs
+    text = (f"too short to diagnose: the record spans {revs:.3g} revolutions of the averaged "
+            "shaft" + (f" ({skip} to be skipped at the start)" if skip else "")
+            + f"; the average needs one whole revolution ({need} revolutions always hold one)")
+    now = f"this one is {seconds:.3g} s" if seconds is not None else ""
+    if per_rev is not None and np.isfinite(per_rev) and per_rev > 0:
+        long = f"{need * per_rev:.3g} s"
+        if simulation:
+            text += f": simulate at least {long} (simulation.record_time; {now or 'longer'})"
+        else:
+            text += f": record at least {long} at this speed" + (f" ({now})" if now else "")
+    else:
+        text += ": a longer record is needed"
+    return DataFileError(path, text)

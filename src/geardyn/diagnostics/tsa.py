@@ -75,6 +75,32 @@ class DiagnosticsWarning(UserWarning):
     """Suspicious but usable input to a :mod:`geardyn.diagnostics` function."""
 
 
+class ShortRecordError(InputError):
+    """:func:`tsa` found no whole revolution to average in the record.
+
+    An :class:`~geardyn.errors.InputError` on ``x`` that also keeps the numbers, so that a caller
+    who knows where the record came from (e.g. :func:`~geardyn.diagnostics.diagnose_file`) can
+    say it in the user's terms.
+
+    Attributes
+    ----------
+    revolutions : float
+        Shaft revolutions the record spans [-] (from the first to the last usable sample).
+    skip : int
+        Revolutions asked to be skipped at the start [-].
+    """
+
+    def __init__(self, revolutions: float, skip: int = 0):
+        self.revolutions = float(revolutions)
+        self.skip = int(skip)
+        super().__init__(
+            "x",
+            f"a record spanning {self.revolutions:.3g} revolutions"
+            + (f" after skipping {self.skip}" if self.skip else ""),
+            "at least one whole revolution (starting at angle_origin + 2*pi*k)",
+        )
+
+
 # --------------------------------------------------------------------------------------------
 # small validation helpers shared by the diagnostics modules
 # --------------------------------------------------------------------------------------------
@@ -643,12 +669,7 @@ def tsa(
     theta_s = origin + TWO_PI * (k0 + skip)
     available = math.floor((ang[-1] + slack - theta_s + dtheta) / TWO_PI)
     if available < 1:
-        raise InputError(
-            "x",
-            f"a record spanning {(ang[-1] - ang[0]) / TWO_PI:.3g} revolutions"
-            + (f" after skipping {skip}" if skip else ""),
-            "at least one whole revolution (starting at angle_origin + 2*pi*k)",
-        )
+        raise ShortRecordError((ang[-1] - ang[0]) / TWO_PI, skip)
     n_rev = available if n_revolutions is None else n_revolutions
     if n_rev > available:
         raise InputError("n_revolutions", n_revolutions,

@@ -509,10 +509,9 @@ def simulate(case, stiffness_map: StiffnessMap | None = None, *, model: str | No
 
         return simulate_transverse(case, stiffness_map, model=which, cracked=cracked,
                                    progress=progress)
-    if case.mesh.friction_coefficient > 0:
-        raise InputError("mesh.friction_coefficient", case.mesh.friction_coefficient,
-                         "0 with simulation.dynamics = '6-dof' (friction acts across the line "
-                         "of action: set simulation.dynamics = 'transverse')")
+    from ..case_checks import check_model_options
+
+    check_model_options(case)  # friction needs the transverse model (also for config validate)
     check_bounded_work(case)  # before any map, matrix or step: refuse runs that would not end
     if stiffness_map is None:
         from ..stiffness import build_map

@@ -174,6 +174,28 @@ class MeasurementChain:
         dc = float(np.sum(frf(np.zeros(1))[:, 0].real * mean))
         return sample_at(spec, n_pad, n_pad * p // q) + dc
 
+    def check_input_rate(self, fs_in: float) -> Fraction:
+        """``fs`` over the input (simulation) rate ``fs_in`` [Hz] as a fraction ``p/q``.
+
+        Checked before a simulation by :func:`geardyn.case_checks.check_measurement` (with
+        ``fs_in = 1/(dt decimation)``) and by :meth:`measure` on the input's time grid.
+
+        Raises
+        ------
+        InputError
+            On ``measurement.fs``: above ``fs_in``, or not a fraction of it with a denominator
+            <= 10000.
+        """
+        fs = self.sensor.fs
+        if fs > fs_in * (1 + 1e-9):
+            raise InputError("measurement.fs", fs, f"at most the simulation's sample rate "
+                             f"1/(dt decimation) = {fs_in:.6g} Hz")
+        ratio = Fraction(fs / fs_in).limit_denominator(10_000)
+        if abs(float(ratio) - fs / fs_in) > 1e-9 * fs / fs_in:
+            raise InputError("measurement.fs", fs, f"a rate whose ratio to the simulation's "
+                             f"sample rate {fs_in:.6g} Hz is a fraction with denominator <= 10000")
+        return ratio
+
     def input_duration(self, record_time: float, dt: float) -> float:
         """Input length [s] needed for ``record_time`` of output at input step ``dt`` [s]."""
         q = Fraction(self.sensor.fs * dt).limit_denominator(10_000).denominator
@@ -216,13 +238,7 @@ class MeasurementChain:
             raise InputError("time", "non-uniform sample times", "a uniform time grid")
         fs_in = 1.0 / dt
         fs = self.sensor.fs
-        if fs > fs_in * (1 + 1e-9):
-            raise InputError("measurement.fs", fs, f"at most the simulation's sample rate "
-                             f"1/(dt decimation) = {fs_in:.6g} Hz")
-        ratio = Fraction(fs / fs_in).limit_denominator(10_000)
-        if abs(float(ratio) - fs / fs_in) > 1e-9 * fs / fs_in:
-            raise InputError("measurement.fs", fs, f"a rate whose ratio to the simulation's "
-                             f"sample rate {fs_in:.6g} Hz is a fraction with denominator <= 10000")
+        ratio = self.check_input_rate(fs_in)
         p, q = ratio.numerator, ratio.denominator
         n = (t.size // q) * q
         n_out_all = n * p // q

@@ -54,6 +54,15 @@ def chain_from_config(cfg: MeasurementConfig | None) -> MeasurementChain:
     return MeasurementChain(path=path, sensor=sensor, tach=tach, seed=cfg.seed)
 
 
+def simulated_case(case: Case, chain: MeasurementChain) -> Case:
+    """The case :func:`measure` simulates: ``simulation.record_time`` lengthened by the chain's
+    lead-in and tail (:meth:`MeasurementChain.input_duration`)."""
+    sim_cfg = case.simulation
+    length = chain.input_duration(sim_cfg.record_time, sim_cfg.dt * sim_cfg.decimation)
+    return case.model_copy(update={"simulation": sim_cfg.model_copy(
+        update={"record_time": length})})
+
+
 def housing_forces(case: Case, stiffness_map, ds) -> np.ndarray:
     """Bearing forces on the housing [N], shape ``(2, n)`` (pinion, gear), of a simulation
     record ``ds`` of ``case`` (paper eqs. 10, 12: ``k_y y + q_y y'`` with the case's bearing
@@ -130,10 +139,7 @@ def measure(case: Case, stiffness_map=None, *, model: str | None = None, cracked
 
         stiffness_map = build_map(case, cracked=cracked)
     sim_cfg = case.simulation
-    step = sim_cfg.dt * sim_cfg.decimation
-    length = chain.input_duration(sim_cfg.record_time, step)
-    long_case = case.model_copy(update={"simulation": sim_cfg.model_copy(
-        update={"record_time": length})})
+    long_case = simulated_case(case, chain)
     ds = simulate(long_case, stiffness_map, model=model, cracked=cracked, progress=progress)
     shaft = "p" if chain.tach.shaft == "pinion" else "g"
     m = chain.measure(ds["time"].values, housing_forces(case, stiffness_map, ds),
