@@ -42,3 +42,63 @@ def test_the_files_pulse_count_is_the_default_and_a_contradiction_is_refused(tmp
     assert line.startswith("error: --pulses-per-rev: got 1") and "2" in line, line
     r = run(tmp_path, stated, *common, "--pulses-per-rev", 2, "--out", tmp_path / "e")
     assert r.returncode == 0, r.stdout + r.stderr  # the file's own count is accepted
+
+
+def test_a_csv_of_geardyn_measure_states_its_rate_teeth_and_pulses(tmp_path):
+    """``geardyn measure --csv`` writes ``# key = value`` provenance (rate, teeth, pulses per
+    revolution); ``diagnose`` reads them as it reads the NetCDF's attributes. Oracle: the same
+    record as NetCDF, diagnosed with nothing but the channel names."""
+    from geardyn.measurement.record import write_csv
+
+    t, theta, acc, _ = _channels()
+    d = np.mod(2 * theta + np.pi, 2 * np.pi) - np.pi
+    tach = 5.0 * np.clip(np.minimum(d, 0.5 - d) / 0.05 + 0.5, 0.0, 1.0)
+    attrs = {"fs": FS, "fs_units": "Hz", "title": "record", "case": "stored",
+             "pinion_teeth": 25, "gear_teeth": 23, "tach_shaft": "pinion",
+             "tach_pulses_per_rev": 2}
+    ds = xr.Dataset({"acc": ("time", acc, {"units": "m/s^2"}),
+                     "acc_g": ("time", acc / 9.80665, {"units": "g"}),
+                     "tach": ("time", tach, {"units": "V"})},
+                    coords={"time": ("time", t, {"units": "s"})}, attrs=attrs)
+    ds.to_netcdf(tmp_path / "rec.nc", engine="h5netcdf")
+    write_csv(ds, tmp_path / "rec.csv")
+    text = (tmp_path / "rec.csv").read_text()
+    assert "# fs = 10000 Hz" in text and "# pinion_teeth = 25" in text
+    for name in ("rec.nc", "rec.csv"):
+        r = run(tmp_path, tmp_path / name, "--signal", "acc", "--tach", "tach", *SMALL,
+                "--out", tmp_path / name.replace(".", "-"))
+        assert r.returncode == 0, r.stdout + r.stderr
+        assert "(teeth 25)" in r.stdout + r.stderr
+    a, b = metrics(tmp_path / "rec-nc"), metrics(tmp_path / "rec-csv")
+    assert a["signals"]["acc"] == b["signals"]["acc"]
+    line = one_error(run(tmp_path, tmp_path / "rec.csv", "--signal", "acc", "--tach", "tach",
+                         "--fs", "20 kHz", *SMALL, "--out", tmp_path / "x"))
+    assert line.startswith("error: --fs: got '20000 Hz'") and "10000 Hz" in line, line
+
+
+def test_options_that_would_be_ignored_are_refused(tmp_path):
+    """Options that do not apply to the file's shaft angle are refused, naming the option (the
+    QA: --angle-unit, --tach-times and --pulses-per-rev were ignored without a word)."""
+    t, theta, acc, _ = _channels()
+    sim = tmp_path / "sim.nc"
+    xr.Dataset({"v_yg": ("time", acc), "theta_p": ("time", theta)}, coords={"time": t},
+               attrs={"pinion_teeth": 25}).to_netcdf(sim, engine="h5netcdf")
+    for extra in (["--angle-unit", "deg"], ["--tach-times"], ["--pulses-per-rev", 2]):
+        line = one_error(run(tmp_path, sim, "--signal", "v_yg", *extra, *SMALL,
+                             "--out", tmp_path / "o"))
+        assert line.startswith(f"error: {extra[0]}: got") and "theta_p" in line, line
+    rec = _two_pulse_record(tmp_path / "rec.nc", True)
+    line = one_error(run(tmp_path, rec, "--signal", "acc", "--tach", "tach", "--angle-unit",
+                         "deg", "--teeth", 25, *SMALL, "--out", tmp_path / "o"))
+    assert line.startswith("error: --angle-unit: got 'deg'") and "--angle" in line, line
+    ang = tmp_path / "ang.csv"
+    np.savetxt(ang, np.column_stack([t, acc, theta]), delimiter=",", header="time,acc,angle",
+               comments="")
+    for extra in (["--tach-times"], ["--pulses-per-rev", 2]):
+        line = one_error(run(tmp_path, ang, "--signal", "acc", "--angle", "angle", "--time",
+                             "time", "--teeth", 25, *extra, *SMALL, "--out", tmp_path / "o"))
+        assert line.startswith(f"error: {extra[0]}: got") and "--tach" in line, line
+    # the same files without those options are diagnosed
+    r = run(tmp_path, ang, "--signal", "acc", "--angle", "angle", "--time", "time", "--teeth",
+            25, *SMALL, "--out", tmp_path / "ok")
+    assert r.returncode == 0, r.stdout + r.stderr

@@ -111,7 +111,6 @@ def measure(
     if m.clipped:
         err_console.print(f"[yellow]warning[/yellow]: the ADC clipped {m.clipped} samples "
                           f"({100 * m.clipped / m.acc.size:.3g} %): raise measurement.adc_range")
-    console.print(f"  diagnose it: geardyn diagnose {out} --signal acc --tach tach --teeth "
-                  f"{case.pinion.teeth if result.chain.tach.shaft == 'pinion' else case.gear.teeth}"
-                  + (f" --pulses-per-rev {result.chain.tach.pulses_per_rev}"
-                     if result.chain.tach.pulses_per_rev > 1 else ""))
+    # the file states its rate, the teeth of the tachometer's shaft and the pulses per
+    # revolution: diagnose reads them
+    console.print(f"  diagnose it: geardyn diagnose {out} --signal acc --tach tach")

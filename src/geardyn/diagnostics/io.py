@@ -9,7 +9,10 @@ Layout rules
 ------------
 CSV / text (``.csv``, ``.txt``, ``.tsv``, ``.dat``)
     One channel per column. The delimiter is detected from the first data line (comma,
-    semicolon, tab, else whitespace); lines starting with ``#`` are comments. If the first line
+    semicolon, tab, else whitespace); lines starting with ``#`` are comments, and a comment
+    ``# key = value`` (as ``geardyn measure --csv`` writes its provenance) is an entry of the
+    file: a number (``fs`` also as ``51200 Hz``) goes to ``scalars``, anything else to
+    ``text``. If the first line
     has a non-numeric field it is a header of column names, otherwise columns are named
     ``"0"``, ``"1"``, ... Empty fields are read as NaN (e.g. a shorter column of tachometer
     pulse times); a row with a different number of fields is a truncated/corrupt file.
@@ -31,6 +34,7 @@ from __future__ import annotations
 import contextlib
 import logging
 import os
+import re
 import warnings
 import zipfile
 from dataclasses import dataclass, field
@@ -57,11 +61,12 @@ class DataTable:
     columns : dict of str to ndarray
         Channel name -> 1-D float64 array (file unit), in file order.
     scalars : dict of str to float
-        Scalar numeric entries of ``.npz``/``.mat``/NetCDF files (e.g. a stored ``fs``).
+        Scalar numeric entries of ``.npz``/``.mat``/NetCDF files and the ``# key = value``
+        comments of text files (e.g. a stored ``fs`` [Hz]).
     text : dict of str to str
         Text entries of ``.mat`` files (``char`` variables and struct fields, dotted like the
-        channels) and NetCDF files (global attributes), e.g. the ``case_toml`` a record of
-        ``geardyn measure`` carries.
+        channels), NetCDF files (global attributes) and text files (``# key = value``
+        comments), e.g. the ``case_toml`` a record of ``geardyn measure`` carries.
     """
 
     path: str
@@ -193,7 +198,30 @@ def _read_text(p: Path) -> DataTable:
     names = header or [str(i) for i in range(ncol)]
     if len(set(names)) != len(names):
         raise DataFileError(p, f"duplicate column names in the header: {names}")
-    return DataTable(str(p), {n: data[:, j].copy() for j, n in enumerate(names)})
+    scalars, text = _comment_entries(lines)
+    return DataTable(str(p), {n: data[:, j].copy() for j, n in enumerate(names)}, scalars, text)
+
+
+#: A ``# key = value`` comment line of a text file.
+_COMMENT_ENTRY = re.compile(r"^\s*#\s*([A-Za-z_][A-Za-z0-9_]*)\s*=\s*(.*?)\s*$")
+
+
+def _comment_entries(lines: list[str]) -> tuple[dict[str, float], dict[str, str]]:
+    """The ``# key = value`` comments of a text file: numbers (``fs`` in Hz, with or without
+    the unit) as scalars, the rest as text; a key given twice keeps its first value."""
+    scalars: dict[str, float] = {}
+    text: dict[str, str] = {}
+    for line in lines:
+        m = _COMMENT_ENTRY.match(line)
+        if m is None or m.group(1) in scalars or m.group(1) in text:
+            continue
+        key, value = m.group(1), m.group(2)
+        number = value[:-2].strip() if key == "fs" and value.endswith("Hz") else value
+        try:
+            scalars[key] = float(number)
+        except ValueError:
+            text[key] = value
+    return scalars, text
 
 
 def _parse_lines(p: Path, body, ncol: int, split) -> np.ndarray:

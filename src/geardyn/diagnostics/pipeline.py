@@ -299,6 +299,16 @@ def load_measurement(
                          "exactly one of an angle column or a tachometer column")
     ang = None
     tach_times = None
+    for key, value, idle in (("tach_column_is_pulse_times", tach_column_is_pulse_times, False),
+                             ("pulses_per_rev", pulses_per_rev, None)):
+        if angle is not None and value != idle:  # tachometer options with an angle channel
+            raise InputError(name_of(key), value, f"no {name_of(key)} with an "
+                             f"{name_of('angle')} channel (it applies to a {name_of('tach')} "
+                             "channel)")
+    if angle is None and angle_unit != "rad":  # the tachometer's angle has no unit to give
+        raise InputError(name_of("angle_unit"), angle_unit,
+                         f"no {name_of('angle_unit')} with a tachometer channel (it is the unit "
+                         f"of an {name_of('angle')} channel)")
     if angle is not None:
         scale = {"rad": 1.0, "deg": np.pi / 180.0, "rev": 2.0 * np.pi}.get(angle_unit)
         if scale is None:
@@ -881,6 +891,16 @@ def diagnose_file(
                                             else [str(s) for s in signals])
         m = load_simulation(path, signals=sig, option_names=option_names)
         _check_own_time_axis(path, m.time, fs, time, name_of)
+        # the exact angle theta_p: the options of a measured angle would be ignored silently
+        for key, value, idle in (("tach_column_is_pulse_times", tach_column_is_pulse_times,
+                                  False), ("pulses_per_rev", pulses_per_rev, None),
+                                 ("angle_unit", angle_unit, "rad")):
+            if value != idle:
+                raise InputError(name_of(key), value,
+                                 f"no {name_of(key)} for a geardyn simulation result: "
+                                 f"{Path(path).name} carries its exact shaft angle (theta_p); "
+                                 f"it applies to a measured {name_of('tach')} or "
+                                 f"{name_of('angle')} channel")
     else:
         if signals is None:
             raise InputError(name_of("signals"), None,

@@ -82,8 +82,9 @@ def write_csv(ds, path: str | os.PathLike) -> None:
     from ..io import write_text_atomic
 
     lines = [f"# fs = {float(ds.attrs['fs']):.17g} Hz"]
-    for k in ("title", "case", "noise_seed", "snr_requested", "noise_rms", "clipped_samples",
-              "tach_pulses_per_rev", "geardyn_version"):
+    for k in ("title", "case", "pinion_teeth", "gear_teeth", "noise_seed", "snr_requested",
+              "noise_rms", "clipped_samples", "tach_shaft", "tach_pulses_per_rev",
+              "geardyn_version"):
         if k in ds.attrs:
             lines.append(f"# {k} = {ds.attrs[k]}")
     names = ["time", "acc", "acc_g", "tach"]

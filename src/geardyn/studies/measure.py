@@ -161,6 +161,8 @@ def measure(case: Case, stiffness_map=None, *, model: str | None = None, cracked
         "adc": (f"{chain.sensor.adc_bits} bits, +/- {chain.sensor.adc_full_scale:.6g} m/s^2"
                 if chain.sensor.adc_bits is not None else "none"),
         "tach_shaft": chain.tach.shaft,
+        "pinion_teeth": int(case.pinion.teeth),
+        "gear_teeth": int(case.gear.teeth),
         "tach_pulses_per_rev": int(chain.tach.pulses_per_rev),
         "tach_jitter": float(chain.tach.jitter),
         "simulation_model": str(ds.attrs.get("model", "")),
