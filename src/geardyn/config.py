@@ -78,6 +78,16 @@ PAPER_CASE = "xue_howard"
 
 
 # --------------------------------------------------------------------------- quantities
+class _QuantityJsonSchema(WithJsonSchema):
+    """:class:`pydantic.WithJsonSchema` that hands out a copy of its schema each time: pydantic
+    2.6 returned the dict itself and then wrote a field's constraints into it (``gt: 0``), so
+    every later schema showed one field's constraint on all quantities of that dimension and
+    two calls of :func:`case_file_schema` differed (found by the dependency floors' run)."""
+
+    def __get_pydantic_json_schema__(self, core_schema, handler):
+        return copy.deepcopy(super().__get_pydantic_json_schema__(core_schema, handler))
+
+
 def _quantity(dimension: str):
     dim = DIMENSIONS[dimension]
 
@@ -94,7 +104,7 @@ def _quantity(dimension: str):
         "x-unit": dim.si_unit,
         "x-dimension": dim.name,
     }
-    return Annotated[float, BeforeValidator(parse), WithJsonSchema(schema)]
+    return Annotated[float, BeforeValidator(parse), _QuantityJsonSchema(schema)]
 
 
 Length = _quantity("length")

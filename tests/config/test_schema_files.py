@@ -153,3 +153,15 @@ def test_a_complete_file_must_hold_every_required_key(validator):
     assert _errors(validator, data) == []  # a partial file: module comes from the base
     del data["extends"]  # the default base
     assert _errors(validator, data) == []
+
+
+def test_the_schema_is_the_same_every_time():
+    """pydantic 2.6 (the floor) wrote a field's constraint into the quantity schema it was given,
+    so a second call showed ``gt: 0`` on every length (the floors' run found the CLI's schema
+    and the in-process one different); each quantity now gets its own copy."""
+    from geardyn.config import case_file_schema
+
+    first = json.dumps(case_file_schema(), sort_keys=True)
+    assert json.dumps(case_file_schema(), sort_keys=True) == first
+    depth = json.loads(first)["$defs"]["CrackConfig"]["properties"]["depth"]["anyOf"][0]
+    assert depth["x-unit"] == "m" and "gt" not in depth and "exclusiveMinimum" not in depth
