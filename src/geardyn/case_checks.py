@@ -21,8 +21,8 @@ physics of its own; each check is the stage's own code:
    :mod:`geardyn.dynamics.model`);
 5. the bounded-work check of the simulation (step count and record size,
    :func:`geardyn.dynamics.newmark.check_bounded_work`);
-6. the model options (:func:`check_model_options`: friction needs the transverse model, which
-   has no HHT and no load family), the faults the stiffness method cannot model
+6. the model options (:func:`geardyn.dynamics.newmark.check_model_options`: friction needs
+   the transverse model, which has no HHT and no load family), the faults the stiffness method cannot model
    (:func:`geardyn.faults.check_method`) and the load family's torques
    (:func:`geardyn.stiffness.build_load_family`);
 7. the set-up of the simulation on the case's stiffness map: :func:`geardyn.dynamics.simulate`
@@ -49,7 +49,7 @@ from __future__ import annotations
 
 import math
 
-__all__ = ["check_case", "check_model_options", "check_measurement", "UNCHECKED_WITHOUT_FE_MAP"]
+__all__ = ["check_case", "check_measurement", "UNCHECKED_WITHOUT_FE_MAP"]
 
 #: What :func:`check_case` cannot check for an FE case whose map is not in the cache.
 UNCHECKED_WITHOUT_FE_MAP = (
@@ -125,29 +125,6 @@ def check_case(case, *, cache=None) -> list[str]:
         notes.append(f"'geardyn measure' would refuse the default [measurement] chain with "
                      f"this case: {exc}")
     return notes
-
-
-def check_model_options(case) -> None:
-    """Refuse options the chosen dynamic model does not have (before any map or matrix).
-
-    ``geardyn.dynamics.simulate`` calls it too. Friction (``mesh.friction_coefficient > 0``)
-    needs ``simulation.dynamics = 'transverse'``; the transverse model refuses HHT-alpha and a
-    load family (:func:`geardyn.dynamics.transverse._refuse_unsupported`).
-
-    Raises
-    ------
-    geardyn.errors.InputError
-    """
-    from .errors import InputError
-
-    if case.simulation.dynamics == "transverse":
-        from .dynamics.transverse import _refuse_unsupported
-
-        _refuse_unsupported(case)
-    elif case.mesh.friction_coefficient > 0:
-        raise InputError("mesh.friction_coefficient", case.mesh.friction_coefficient,
-                         "0 with simulation.dynamics = '6-dof' (friction acts across the line "
-                         "of action: set simulation.dynamics = 'transverse')")
 
 
 def check_measurement(case):
@@ -243,6 +220,7 @@ def _cached_only(cache):
 
 def _check_dynamics(case, cache) -> list[str]:
     """Checks 6-7 of the module docstring; the notes of what was not checked."""
+    from .dynamics.newmark import check_model_options
     from .faults import check_method
     from .stiffness import build_load_family, build_map, centre_distance_grid
 

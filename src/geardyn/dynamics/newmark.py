@@ -509,8 +509,6 @@ def simulate(case, stiffness_map: StiffnessMap | None = None, *, model: str | No
 
         return simulate_transverse(case, stiffness_map, model=which, cracked=cracked,
                                    progress=progress)
-    from ..case_checks import check_model_options
-
     check_model_options(case)  # friction needs the transverse model (also for config validate)
     check_bounded_work(case)  # before any map, matrix or step: refuse runs that would not end
     if stiffness_map is None:
@@ -620,6 +618,28 @@ def _extreme_fields(case) -> list[str]:
 
     walk(data, "")
     return out
+
+
+def check_model_options(case) -> None:
+    """Refuse options the chosen dynamic model does not have (before any map or matrix).
+
+    :func:`simulate` and ``geardyn config validate`` (:mod:`geardyn.case_checks`) call it.
+    Friction (``mesh.friction_coefficient > 0``)
+    needs ``simulation.dynamics = 'transverse'``; the transverse model refuses HHT-alpha and a
+    load family (:func:`geardyn.dynamics.transverse._refuse_unsupported`).
+
+    Raises
+    ------
+    geardyn.errors.InputError
+    """
+    if case.simulation.dynamics == "transverse":
+        from .transverse import _refuse_unsupported
+
+        _refuse_unsupported(case)
+    elif case.mesh.friction_coefficient > 0:
+        raise InputError("mesh.friction_coefficient", case.mesh.friction_coefficient,
+                         "0 with simulation.dynamics = '6-dof' (friction acts across the line "
+                         "of action: set simulation.dynamics = 'transverse')")
 
 
 def check_bounded_work(case) -> int:
