@@ -123,3 +123,17 @@ def test_a_contact_ratio_above_2_says_two_or_three_pairs():
             f"{op.double_contact_fraction:.4f}") in out
     assert f"note: contact ratio {op.contact_ratio:.4f} >= 2" in out
     assert "2 or 3 tooth pairs share the load" in out
+
+
+def test_static_te_refuses_the_same_centre_distances(tmp_path):
+    """``geardyn static-te --centre-distance-change`` takes the same operating point as
+    ``geometry``: a negative backlash is refused before any map is built (the QA saw it accepted
+    down to the map's range)."""
+    env = {**os.environ, "GEARDYN_CACHE_DIR": str(tmp_path / "cache")}
+    r = run_geardyn(["static-te", "--stiffness", "pem", "--centre-distance-change", "-0.5 mm",
+                     "--out", str(tmp_path / "te.nc")], capture_output=True, text=True,
+                    timeout=120, env=env)
+    line = _one_error_line(r)
+    assert line.startswith("error: --centre-distance-change: got -0.5 mm;") and \
+        "interpenetrate" in line, line
+    assert not (tmp_path / "te.nc").exists() and not (tmp_path / "cache").exists()

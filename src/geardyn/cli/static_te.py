@@ -78,6 +78,9 @@ def static_te(
     if not (tq >= 0 and tq < float("inf")):
         raise InputError("--torque", torque, "a finite pinion torque >= 0 [N m]")
     dd = to_si(centre_distance_change, "length", "--centre-distance-change")
+    from .geometry import operating_summary
+
+    operating_summary(case.gear_pair(), dd)  # the teeth apart and in mesh, as geometry checks
     has_crack = case.crack is not None and case.crack.active
     if crack and not has_crack:
         raise InputError("--crack", "the case has no enabled crack", "--no-crack, or a case "
