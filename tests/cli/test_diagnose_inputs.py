@@ -113,13 +113,18 @@ def test_teeth_of_the_gear_when_the_records_tachometer_reads_the_gear(tmp_path):
     assert metrics(out)["settings"]["teeth"] == 23  # [gear] teeth of the stored case
 
 
-def test_teeth_option_wins_and_files_without_a_case_use_the_config_case(tmp_path):
-    """--teeth over the file; a NetCDF record without a stored case defaults like the same data
-    as CSV: the pinion of the --config case (the paper's, 23 teeth)."""
+def test_teeth_option_for_files_that_do_not_state_it_and_the_config_case_default(tmp_path):
+    """--teeth where the file says nothing; a count contradicting a stored case is refused (it
+    would move every mesh order: the QA's second walkthrough diagnosed a 23-tooth record with
+    --teeth 31 into meaningless numbers); a NetCDF record without a stored case defaults like
+    the same data as CSV: the pinion of the --config case (the paper's, 23 teeth)."""
     rec = write_record(tmp_path / "rec.nc", case_teeth=25)
     bare = write_record(tmp_path / "bare.nc", case_teeth=None)
     csv = write_record(tmp_path / "rec.csv")
-    runs = {"teeth": (rec, ["--teeth", "30"]), "bare": (bare, []),
+    line = one_error(run(tmp_path, rec, "--signal", "acc", "--tach", "tach", "--teeth", "30",
+                         "--no-figures", "-o", tmp_path / "x", *SMALL))
+    assert line.startswith("error: --teeth: got 30") and "25" in line, line
+    runs = {"teeth": (bare, ["--teeth", "30"]), "bare": (bare, []),
             "csv": (csv, ["--fs", "10 kHz"])}
     kurt = {}
     for key, (path, extra) in runs.items():

@@ -102,3 +102,29 @@ def test_options_that_would_be_ignored_are_refused(tmp_path):
     r = run(tmp_path, ang, "--signal", "acc", "--angle", "angle", "--time", "time", "--teeth",
             25, *SMALL, "--out", tmp_path / "ok")
     assert r.returncode == 0, r.stdout + r.stderr
+
+
+def test_a_simulations_own_teeth_cannot_be_contradicted(tmp_path):
+    """A simulation record averages over theta_p: a --teeth other than its pinion's is refused
+    (it exited 0 with every mesh order misplaced); its own count is accepted."""
+    t, theta, acc, _ = _channels()
+    sim = tmp_path / "sim.nc"
+    xr.Dataset({"v_yg": ("time", acc), "theta_p": ("time", theta)}, coords={"time": t},
+               attrs={"pinion_teeth": 25}).to_netcdf(sim, engine="h5netcdf")
+    line = one_error(run(tmp_path, sim, "--signal", "v_yg", "--teeth", 31, *SMALL,
+                         "--out", tmp_path / "o"))
+    assert line.startswith("error: --teeth: got 31") and "theta_p" in line and "25" in line
+    r = run(tmp_path, sim, "--signal", "v_yg", "--teeth", 25, *SMALL, "--out", tmp_path / "ok")
+    assert r.returncode == 0, r.stdout + r.stderr
+
+
+def test_pwvd_max_order_must_be_a_positive_number():
+    import pytest
+
+    from geardyn.diagnostics import diagnose
+    from geardyn.errors import InputError
+
+    t, theta, acc, _ = _channels()
+    for bad in (float("nan"), -1.0, 0.0, "10", True):
+        with pytest.raises(InputError, match="pwvd_max_order"):
+            diagnose({"acc": acc}, teeth=25, angle=theta, pwvd_max_order=bad)

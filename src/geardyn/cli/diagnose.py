@@ -41,10 +41,11 @@ def diagnose(
         "--signal", help="Signal column/variable (repeatable). Default for a simulation: "
                          "v_yg, omega_p, transmission_error.", show_default=False)] = None,
     teeth: Annotated[int | None, typer.Option(
-        "--teeth", help="Teeth on the shaft whose angle is given (default: the simulation's "
-                        "pinion; for measured data the pinion of the case FILE stores, as a "
-                        "record of geardyn measure does (the gear if its tachometer reads the "
-                        "gear), else the pinion of the --config case).",
+        "--teeth", help="Teeth on the shaft whose angle is given, for files that do not "
+                        "state it (default: the simulation's pinion; for measured data the "
+                        "pinion of the case FILE stores, as a record of geardyn measure does "
+                        "(the gear if its tachometer reads the gear), else the pinion of the "
+                        "--config case). A count that contradicts the file is refused.",
         show_default=False)] = None,
     fs: Annotated[str | None, typer.Option("--fs", help="Sampling rate of measured data: Hz, or "
                                                         "with a unit (Hz, kHz, MHz, 1/s), e.g. "

@@ -739,6 +739,12 @@ def diagnose(
         raise InputError("signals", type(signals).__name__,
                          "a non-empty mapping of name -> 1-D array")
     z = _check_int(teeth, "teeth", 1, "a positive integer number of teeth")
+    if pwvd_max_order is not None and not (isinstance(pwvd_max_order, int | float)
+                                           and not isinstance(pwvd_max_order, bool)
+                                           and math.isfinite(pwvd_max_order)
+                                           and pwvd_max_order > 0):
+        raise InputError("pwvd_max_order", pwvd_max_order,
+                         "a finite positive order (shaft orders), or None for the default")
     arrays = {}
     for name, arr in signals.items():
         a = np.asarray(arr, dtype=np.float64)
@@ -910,6 +916,13 @@ def diagnose_file(
                              pulses_per_rev=pulses_per_rev, tach_threshold=tach_threshold,
                              angle_unit=angle_unit, unwrap_angle=unwrap_angle,
                              option_names=option_names)
+    if teeth is not None and m.teeth is not None and int(teeth) != m.teeth:
+        # the file states the teeth of the shaft it averages over: another count puts every
+        # mesh order in the wrong place (no error otherwise, only wrong numbers)
+        shaft = "the pinion (theta_p)" if simulation else "the tachometer's shaft"
+        raise InputError(name_of("teeth"), int(teeth),
+                         f"{Path(path).name}'s own count for {shaft}, {m.teeth}, or no "
+                         f"{name_of('teeth')}: the file states it")
     z = teeth if teeth is not None else m.teeth
     if z is None and not simulation:
         z = default_teeth
