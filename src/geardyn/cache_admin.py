@@ -169,6 +169,10 @@ def prune(cache: Cache | None = None, *, kinds: tuple[str, ...] | None = None,
     all_entries = _entries(cache)
     if kinds is not None:
         present = list(all_entries)
+        # a kind with a space ("map values") may be typed unquoted as map_values or map-values
+        spelled = {k.replace(" ", "_"): k for k in present} | {k.replace(" ", "-"): k
+                                                               for k in present}
+        kinds = [spelled.get(k, k) for k in kinds]
         for k in kinds:
             if k not in present:
                 raise InputError("--kind", k, "one of the kinds in the cache: "

@@ -146,3 +146,18 @@ def test_the_commands(tmp_path):
     assert r.returncode == 0 and " 0 " in r.stdout
     r = _cli("cache", "info", cache=tmp_path / "never-made")
     assert r.returncode == 0 and "empty" in r.stdout
+
+
+def test_a_kind_with_a_space_may_be_typed_with_an_underscore_or_a_hyphen(tmp_path):
+    """``map values`` (the study's map numbers) is the one kind with a space: ``--kind
+    map_values`` or ``map-values`` name it without shell quotes."""
+    now = time.time()
+    cache = Cache(tmp_path / "c", enabled=True)
+    for key in ("a", "b"):
+        cache.get_or_build("map values", key, ".json", lambda: b"{}",
+                           lambda d, p: Path(p).write_bytes(d), lambda p: Path(p).read_bytes())
+    for spelling in ("map_values", "map-values"):
+        dry = prune(cache, kinds=(spelling,), dry_run=True, now=now)
+        assert dry.removed["map values"][0] == 2, spelling
+    with pytest.raises(InputError, match="--kind"):
+        prune(cache, kinds=("map__values",))
