@@ -29,6 +29,7 @@ import copy
 import functools
 import json
 import math
+import os
 import re
 import stat
 import tomllib
@@ -620,12 +621,14 @@ class Case(_Model):
                        source: str = "override") -> Case:
         """A new case with dotted-key overrides applied (validated again).
 
-        The overridden values get ``source`` as their provenance (the CLI's ``--set`` goes
-        through :func:`load_case`, which records ``"--set"``).
+        ``overrides``: a mapping of dotted keys to values, ``"key=value"`` strings, or one such
+        string (as in :func:`load_case`). The overridden values get ``source`` as their
+        provenance (the CLI's ``--set`` goes through :func:`load_case`, which records
+        ``"--set"``).
         """
         data = self.model_dump(mode="python")
         prov = data.pop("provenance")
-        ov = parse_overrides(overrides) if not isinstance(overrides, Mapping) else overrides
+        ov = _overrides_dict(overrides)
         for key, value in ov.items():
             _set_dotted(data, key, value)
             _drop_under(prov, key)
@@ -983,10 +986,13 @@ def _set_dotted(data: dict, key: str, value: Any) -> None:
     node[parts[-1]] = value
 
 
-def parse_overrides(items: Iterable[str]) -> dict[str, Any]:
+def parse_overrides(items: Iterable[str] | str) -> dict[str, Any]:
     """Parse ``key=value`` strings; values are TOML values when they parse, else strings.
 
-    Values longer than :data:`MAX_OVERRIDE_CHARS` and control characters are refused.
+    ``items`` is an iterable of strings, or one string (a single override: ``"pinion.teeth=25"``
+    is ``["pinion.teeth=25"]``, not its characters). Values longer than
+    :data:`MAX_OVERRIDE_CHARS` and control characters are refused; anything else than strings
+    raises :class:`InputError` naming ``overrides``.
 
     Examples
     --------
@@ -994,7 +1000,14 @@ def parse_overrides(items: Iterable[str]) -> dict[str, Any]:
     {'pinion.teeth': 25, 'simulation.dt': '5e-6 s', 'crack.enabled': False}
     """
     out: dict[str, Any] = {}
+    if isinstance(items, str):
+        items = [items]
+    elif isinstance(items, bytes | bytearray | Mapping) or not isinstance(items, Iterable):
+        raise InputError("overrides", items, "'key=value' strings: a list of them or one, e.g. "
+                                             "['pinion.teeth=25']")
     for item in items:
+        if not isinstance(item, str):
+            raise InputError("overrides", item, "'key=value' strings, e.g. 'pinion.teeth=25'")
         if "=" not in item:
             raise InputError("--set", item, "key=value, e.g. 'pinion.teeth=25' or "
                                             "'simulation.dt=\"5e-6 s\"'")
@@ -1020,6 +1033,24 @@ def parse_overrides(items: Iterable[str]) -> dict[str, Any]:
         _check_strings(value, key)
         out[key] = value
     return out
+
+
+_OVERRIDES_ALLOWED = ("a 'key=value' string, a list of them (e.g. ['pinion.teeth=25']), or a "
+                      "mapping of dotted keys to values (e.g. {'pinion.teeth': 25})")
+
+
+def _overrides_dict(overrides: Iterable[str] | Mapping[str, Any] | str) -> dict[str, Any]:
+    """The overrides of :func:`load_case` / :meth:`Case.with_overrides` as ``{dotted key:
+    value}``: a mapping (its keys strings) is copied, strings go through
+    :func:`parse_overrides`."""
+    if not isinstance(overrides, Mapping):
+        if isinstance(overrides, bytes | bytearray) or not isinstance(overrides, Iterable):
+            raise InputError("overrides", overrides, _OVERRIDES_ALLOWED)
+        return parse_overrides(overrides)
+    for key in overrides:
+        if not isinstance(key, str):
+            raise InputError("overrides", key, "dotted keys (strings) such as 'pinion.teeth'")
+    return dict(overrides)
 
 
 def _format_validation_error(exc: ValidationError, data: Mapping[str, Any]) -> InputError:
@@ -1122,9 +1153,12 @@ def load_case_details(path: str | Path | None = None,
                       overrides: Iterable[str] | Mapping[str, Any] = (), *,
                       override_source: str = SET_SOURCE) -> CaseDetails:
     """:func:`load_case` keeping the values as written and where each came from."""
+    if path is not None and not isinstance(path, str | os.PathLike):
+        raise InputError("path", path, "a case file path (str or pathlib.Path), or None for the "
+                                       "paper's case")
+    ov = _overrides_dict(overrides)
     layers = _shipped_layer(PAPER_CASE, ()) if path is None else _file_layer(Path(path), ())
     data, prov, origin = layers.data, layers.prov, layers.origin
-    ov = dict(overrides) if isinstance(overrides, Mapping) else parse_overrides(overrides)
     before = copy.deepcopy(data) if ov else data  # to tell a change from a repeated value
     for key, value in ov.items():
         if isinstance(overrides, Mapping):
@@ -1237,8 +1271,9 @@ def load_case(path: str | Path | None = None, overrides: Iterable[str] | Mapping
     ----------
     path : str or Path, optional
         A TOML case file. ``None`` loads the paper's case shipped with geardyn.
-    overrides : iterable of str or mapping
-        ``"dotted.key=value"`` strings (or a mapping) applied before validation.
+    overrides : iterable of str, str or mapping
+        ``"dotted.key=value"`` strings (or a mapping) applied before validation; a single
+        string is one override (``"pinion.teeth=25"`` means ``["pinion.teeth=25"]``).
     override_source : str
         Source recorded for the overridden values.
 
@@ -1253,12 +1288,17 @@ def load_case(path: str | Path | None = None, overrides: Iterable[str] | Mapping
         UTF-8, not valid TOML or nested deeper than :data:`MAX_NESTING`.
     InputError
         If a value is invalid; the message names the dotted key, the value and what is allowed.
+        Also for a ``path`` that is not a str or path, and ``overrides`` that are not strings or
+        a mapping with string keys (field ``"path"`` or ``"overrides"``).
     """
     return load_case_details(path, overrides, override_source=override_source).case
 
 
 def paper_case(overrides: Iterable[str] | Mapping[str, Any] = ()) -> Case:
-    """The paper's case (Xue & Howard 2018, Table 1 plus documented defaults)."""
+    """The paper's case (Xue & Howard 2018, Table 1 plus documented defaults).
+
+    ``overrides`` as in :func:`load_case`: ``"key=value"`` strings, one such string, or a mapping.
+    """
     return load_case(None, overrides)
 
 

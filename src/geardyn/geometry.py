@@ -51,6 +51,38 @@ __all__ = [
 ]
 
 
+#: Largest pinion angle magnitude :meth:`GearPair.contact_points` takes [rad] (about 1.6e11
+#: revolutions): the pair index ``n`` stays an exact 64-bit integer.
+MAX_ANGLE = 1e12
+
+
+def _real(value, field_name: str, allowed: str, *, finite: bool = True) -> float:
+    """``value`` as a finite float (any float if not ``finite``), or :class:`InputError` naming
+    ``field_name``.
+
+    Numbers only (Python or NumPy, 0-d arrays included); a string, ``None``, a bool or an
+    array with several values is refused: this module works in SI numbers (unit strings such as
+    ``"1 mm"`` are read by case files and the command line, :func:`geardyn.units.to_si`).
+    """
+    if isinstance(value, float | int) and not isinstance(value, bool):  # np.float64 is a float
+        out = float(value)
+    elif (isinstance(value, np.generic | np.ndarray) and np.ndim(value) == 0
+          and np.asarray(value).dtype.kind in "iuf"):
+        out = float(value)
+    else:
+        raise InputError(field_name, value, allowed)
+    if finite and not math.isfinite(out):
+        raise InputError(field_name, value, allowed)
+    return out
+
+
+def _count(value, field_name: str, minimum: int) -> int:
+    """``value`` as an int >= ``minimum`` (Python or NumPy integer, not a bool)."""
+    if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < minimum:
+        raise InputError(field_name, value, f"a whole number >= {minimum}")
+    return int(value)
+
+
 def inv(alpha: float | np.ndarray) -> float | np.ndarray:
     r"""Involute function :math:`\mathrm{inv}\,\alpha = \tan\alpha - \alpha` (alpha in rad)."""
     return np.tan(alpha) - alpha
@@ -73,6 +105,20 @@ def inv_inverse(value: float) -> float:
         if abs(step) < 1e-16:
             break
     return a
+
+
+#: The number fields of :class:`Gear` and what they take (checked for their type first, so that
+#: a string is refused by name rather than failing in a comparison).
+_GEAR_NUMBERS = {
+    "module": "a length in m (a number; SI: 0.003 for 3 mm)",
+    "pressure_angle": "an angle in rad (a number; 0.3491 for 20 deg)",
+    "addendum_coefficient": "a number (in modules)",
+    "dedendum_coefficient": "a number (in modules)",
+    "profile_shift": "a number (in modules)",
+    "face_width": "a length in m (a number; SI: 0.02 for 20 mm)",
+    "bore_radius": "a length in m (a number; SI: 0.02 for 20 mm)",
+    "tool_tip_radius_coefficient": "a number (in modules) or None",
+}
 
 
 @dataclass(frozen=True)
@@ -118,6 +164,12 @@ class Gear:
         if isinstance(self.teeth, bool) or not isinstance(self.teeth, int | np.integer) \
                 or self.teeth < 5:
             raise InputError("teeth", self.teeth, "a whole number of teeth >= 5")
+        for name, what in _GEAR_NUMBERS.items():
+            v = getattr(self, name)
+            if v is None and name == "tool_tip_radius_coefficient":
+                continue
+            if isinstance(v, bool) or not isinstance(v, float | int | np.integer | np.floating):
+                raise InputError(name, v, what)
         for name in ("module", "face_width", "bore_radius"):
             v = getattr(self, name)
             if not (math.isfinite(v) and v > 0):
@@ -222,8 +274,10 @@ class Gear:
     def thickness_at(self, radius: float) -> float:
         r"""Arc tooth thickness at a radius on the involute [m]:
         :math:`s_y = 2 r_y(\alpha_2 - \mathrm{inv}\,\alpha_y)`, :math:`\cos\alpha_y = r_b/r_y`."""
+        allowed = f"a radius >= the base radius {self.base_radius:.6g} m"
+        radius = _real(radius, "radius", f"a finite {allowed[2:]}")
         if radius < self.base_radius:
-            raise InputError("radius", radius, f"a radius >= the base radius {self.base_radius:.6g} m")
+            raise InputError("radius", radius, allowed)
         ay = math.acos(self.base_radius / radius)
         return 2 * radius * (self.base_half_angle - float(inv(ay)))
 
@@ -264,13 +318,15 @@ class Gear:
         Parameters
         ----------
         n_involute, n_fillet : int
-            Number of points on each part.
+            Number of points on each part (>= 2).
 
         Returns
         -------
         ToothOutline
             Points in m.
         """
+        n_involute = _count(n_involute, "n_involute", 2)
+        n_fillet = _count(n_fillet, "n_fillet", 2)
         rb, ra = self.base_radius, self.tip_radius
         a2 = self.base_half_angle
         u0 = max(self.form_roll_length, 0.0) / rb  # roll parameter at the form circle
@@ -430,6 +486,9 @@ class OperatingGeometry:
         Transverse backlash on the operating pitch circle ``j_t = j_n / cos alpha'`` [m].
     closing_rotation : float
         Pinion rotation that closes the backlash with the gear held ``j_n / r_b1`` [rad].
+    base_pitch : float
+        Base pitch ``p_b = pi m cos(alpha)`` [m], the same for every centre distance (the
+        divisor of ``contact_ratio``; not shown in the repr).
     """
 
     centre_distance: float
@@ -482,6 +541,9 @@ class GearPair:
     """
 
     def __init__(self, pinion: Gear, gear: Gear):
+        for name, g in (("pinion", pinion), ("gear", gear)):
+            if not isinstance(g, Gear):
+                raise InputError(name, g, "a geardyn.geometry.Gear")
         if not math.isclose(pinion.module, gear.module, rel_tol=1e-12):
             raise InputError("gear.module", gear.module, f"the pinion's module {pinion.module} m")
         if not math.isclose(pinion.pressure_angle, gear.pressure_angle, rel_tol=1e-12):
@@ -552,7 +614,7 @@ class GearPair:
         Parameters
         ----------
         centre_distance_change : float
-            ``d' - d`` [m].
+            ``d' - d`` [m], a finite number (SI; a unit string such as ``"1 mm"`` is refused).
         check : bool
             Raise :class:`GeometryError` if the contact ratio is below 1 (the pair cannot keep
             contact) or the centre distance is below the base-radius sum.
@@ -561,9 +623,11 @@ class GearPair:
         -------
         OperatingGeometry
         """
-        dd = float(centre_distance_change)
-        d = self.design_centre_distance + dd
         rsum = self.base_radius_sum
+        dd = _real(centre_distance_change, "centre_distance_change",
+                   f"a number > {rsum - self.design_centre_distance:.6g} [m] "
+                   "(SI: 0.001 for 1 mm)", finite=False)
+        d = self.design_centre_distance + dd
         if not math.isfinite(dd) or d <= rsum:
             raise GeometryError("centre_distance_change", dd,
                                 f"a change > {rsum - self.design_centre_distance:.6g} m "
@@ -628,17 +692,25 @@ class GearPair:
         Parameters
         ----------
         theta : float
-            Pinion angle [rad] (0: pinion tooth 0 at the design pitch point).
+            Pinion angle [rad] (0: pinion tooth 0 at the design pitch point), finite, of
+            magnitude <= :data:`MAX_ANGLE`.
         centre_distance_change : float
             ``d' - d`` [m].
         margin : float
-            Also return candidate pairs up to ``margin`` base pitches outside the contact interval
-            (for extended-contact searches), flagged ``in_contact = False``.
+            Also return candidate pairs up to ``margin`` (finite, >= 0) base pitches outside the
+            contact interval (for extended-contact searches), flagged ``in_contact = False``.
 
         Returns
         -------
         ContactPoints
         """
+        theta = _real(theta, "theta", f"a finite pinion angle of magnitude <= {MAX_ANGLE:g} [rad]")
+        if abs(theta) > MAX_ANGLE:
+            raise InputError("theta", theta, f"a finite pinion angle of magnitude <= "
+                                             f"{MAX_ANGLE:g} [rad]")
+        margin = _real(margin, "margin", "a finite number of base pitches >= 0")
+        if margin < 0:
+            raise InputError("margin", margin, "a finite number of base pitches >= 0")
         op = self.operating(centre_distance_change, check=False)
         pb = self.base_pitch
         s_theta = self.pitch_point_s + self.pinion.base_radius * theta
@@ -700,18 +772,44 @@ def centre_distance_from_displacements(pair: GearPair, y_p: float | np.ndarray,
     Parameters
     ----------
     pair : GearPair
-    y_p, y_g : float or ndarray
-        Pinion and gear centre displacements along the nominal LOA [m].
+    y_p, y_g : float or array_like
+        Pinion and gear centre displacements along the nominal LOA [m], finite numbers (SI).
 
     Returns
     -------
     float or ndarray
-        ``d'`` [m]; equals the design centre distance for zero displacements.
+        ``d'`` [m]; equals the design centre distance for zero displacements. An array when
+        ``y_p`` or ``y_g`` is an array (or a list or tuple).
+
+    Raises
+    ------
+    InputError
+        ``pair`` not a :class:`GearPair`; a displacement that is not a finite number (or an
+        array of them).
     """
+    if not isinstance(pair, GearPair):
+        raise InputError("pair", pair, "a geardyn.geometry.GearPair")
     rsum = pair.base_radius_sum
-    return np.hypot(rsum, pair.design_t1t2 + np.asarray(y_g) - np.asarray(y_p)) \
-        if isinstance(y_p, np.ndarray) or isinstance(y_g, np.ndarray) \
-        else math.hypot(rsum, pair.design_t1t2 + y_g - y_p)
+    if isinstance(y_p, np.ndarray | list | tuple) or isinstance(y_g, np.ndarray | list | tuple):
+        yp, yg = _displacements(y_p, "y_p"), _displacements(y_g, "y_g")
+        return np.hypot(rsum, pair.design_t1t2 + yg - yp)
+    allowed = "a finite displacement [m] (a number, or an array of them)"
+    return math.hypot(rsum, pair.design_t1t2 + _real(y_g, "y_g", allowed)
+                      - _real(y_p, "y_p", allowed))
+
+
+def _displacements(value, field_name: str) -> np.ndarray:
+    """``value`` as a float array of finite displacements [m], or :class:`InputError`."""
+    allowed = "a finite displacement [m] (a number, or an array of them)"
+    arr = np.asarray(value) if isinstance(value, np.ndarray | list | tuple) else None
+    if arr is None:
+        return np.asarray(_real(value, field_name, allowed))
+    if arr.dtype.kind not in "iuf":
+        raise InputError(field_name, value, allowed)
+    arr = arr.astype(float, copy=False)
+    if not np.all(np.isfinite(arr)):
+        raise InputError(field_name, "an array with non-finite entries", allowed)
+    return arr
 
 
 def static_operating_point(pair: GearPair, torque: float, pinion_bearing_stiffness: float,
@@ -728,8 +826,15 @@ def static_operating_point(pair: GearPair, torque: float, pinion_bearing_stiffne
     torque : float
         Input torque on the pinion [N m].
     pinion_bearing_stiffness, gear_bearing_stiffness : float
-        Bearing stiffnesses along the LOA [N/m].
+        Bearing stiffnesses along the LOA [N/m], finite and > 0.
     """
+    if not isinstance(pair, GearPair):
+        raise InputError("pair", pair, "a geardyn.geometry.GearPair")
+    torque = _real(torque, "torque", "a finite torque [N m]")
+    for name, k in (("pinion_bearing_stiffness", pinion_bearing_stiffness),
+                    ("gear_bearing_stiffness", gear_bearing_stiffness)):
+        if not _real(k, name, "a finite stiffness > 0 [N/m]") > 0:
+            raise InputError(name, k, "a finite stiffness > 0 [N/m]")
     n = torque / pair.pinion.base_radius
     d = centre_distance_from_displacements(pair, -n / pinion_bearing_stiffness,
                                            n / gear_bearing_stiffness)

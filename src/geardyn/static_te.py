@@ -23,14 +23,37 @@ The bearings and the centre distance are held fixed (a rigid single-flank tester
 from __future__ import annotations
 
 import math
+import numbers
 
 import numpy as np
 
 from .errors import InputError
 from .modifications import ToothModifications
+from .units import to_si
 
 __all__ = ["static_transmission_error", "solve_approach", "static_te_of_case",
            "static_te_curves", "fig_static_te"]
+
+
+def _quantity(value, dimension: str, field: str) -> float:
+    """A number (SI) or a quantity string such as ``"100 N m"`` (as in case files,
+    :func:`geardyn.units.to_si`) as an SI float; anything else raises :class:`InputError`
+    naming ``field``. Range checks are the caller's."""
+    if isinstance(value, str):
+        return to_si(value, dimension, field)
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        example = {"torque": "100.0 or '100 N m'", "length": "0.001 or '1 mm'"}[dimension]
+        raise InputError(field, value, f"a {dimension}: a number in SI units or a string with "
+                                       f"a unit, e.g. {example}")
+    return float(value)
+
+
+def _check_case(case) -> None:
+    from .config import Case
+
+    if not isinstance(case, Case):
+        raise InputError("case", case, "a geardyn.config.Case (geardyn.load_case(path) or "
+                                       "geardyn.paper_case())")
 
 
 def solve_approach(k: np.ndarray, e: np.ndarray, force: float) -> tuple[float, int]:
@@ -77,14 +100,16 @@ def static_transmission_error(stiffness_map, torque: float, *,
     ----------
     stiffness_map : StiffnessMap
         ``k_mb`` and (if present) ``load_share`` of the pair (equal shares otherwise).
-    torque : float
-        Pinion torque [N m], ``>= 0`` (0: unloaded TE).
+    torque : float or str
+        Pinion torque [N m], ``>= 0`` (0: unloaded TE); a number, or a string with a unit
+        as in a case file (``"100 N m"``).
     modifications : ToothModifications
         Errors and relief (``ToothModifications.none(pair)`` for perfect involutes).
     theta : array_like, optional
         Pinion angles [rad]; default ``n`` points over one hunting period.
-    centre_distance_change : float
-        ``d' - d`` [m] (must lie in the map's range).
+    centre_distance_change : float or str
+        ``d' - d`` [m] (must lie in the map's range); a number, or a string with a unit
+        (``"0.5 mm"``).
     n : int
         Points of the default grid.
 
@@ -102,9 +127,19 @@ def static_transmission_error(stiffness_map, torque: float, *,
     """
     import xarray as xr
 
+    torque_in = torque
+    torque = _quantity(torque, "torque", "torque")
     if not (math.isfinite(torque) and torque >= 0):
-        raise InputError("torque", torque, "a finite pinion torque >= 0 [N m]")
-    if not stiffness_map.covers(centre_distance_change):
+        raise InputError("torque", torque_in, "a finite pinion torque >= 0 [N m]")
+    if not (callable(stiffness_map) and hasattr(stiffness_map, "covers")):  # duck maps allowed
+        raise InputError("stiffness_map", stiffness_map,
+                         "a geardyn.stiffness.StiffnessMap (e.g. geardyn.stiffness.build_map(case))")
+    if not hasattr(modifications, "pair_errors"):
+        raise InputError("modifications", modifications, "a geardyn.modifications."
+                         "ToothModifications (ToothModifications.none(pair) for perfect involutes)")
+    centre_distance_change = _quantity(centre_distance_change, "length", "centre_distance_change")
+    if not (math.isfinite(centre_distance_change)
+            and stiffness_map.covers(centre_distance_change)):
         raise InputError("centre_distance_change", centre_distance_change,
                          f"a value in the map's range [{stiffness_map.dd[0]:.6g}, "
                          f"{stiffness_map.dd[-1]:.6g}] m")
@@ -112,6 +147,8 @@ def static_transmission_error(stiffness_map, torque: float, *,
     pair = mods.pair
     rb1 = pair.pinion.base_radius
     if theta is None:
+        if isinstance(n, bool) or not isinstance(n, int | np.integer) or n < 1:
+            raise InputError("n", n, "a whole number of points >= 1")
         theta = np.arange(n) * mods.hunting_period / n
     th = np.atleast_1d(np.asarray(theta, float))
     dd = float(centre_distance_change)
@@ -148,7 +185,15 @@ def static_te_of_case(case, torque: float | None = None, *, cracked: bool = Fals
                       errors: bool = True, stiffness_map=None, **kw):
     """:func:`static_transmission_error` of a case: its map (healthy by default), its
     ``[modifications]`` (``errors=False``: perfect involutes) and ``torque`` (default: the
-    motor torque) [N m]."""
+    motor torque) [N m].
+
+    ``torque`` (and ``centre_distance_change`` among ``kw``) may be a number in SI units or a
+    string with a unit as in a case file (``"100 N m"``, ``"0.5 mm"``), like the case's own
+    values; anything else raises :class:`geardyn.errors.InputError` naming the argument.
+    """
+    _check_case(case)
+    if torque is not None:  # refused by name before a map is built
+        torque = _quantity(torque, "torque", "torque")
     if stiffness_map is None:
         from .stiffness import build_map
 
@@ -166,7 +211,8 @@ def static_te_curves(case, torque: float | None = None, *, cracked: bool = False
 
     :func:`static_te_of_case` at ``0`` and at ``torque`` (default the motor torque) [N m],
     stacked along a ``torque`` coordinate [N m], with the case's provenance in the attributes
-    (what ``geardyn static-te`` writes).
+    (what ``geardyn static-te`` writes). ``torque`` and ``centre_distance_change`` take numbers
+    in SI units or strings with a unit, as :func:`static_te_of_case`.
 
     Returns
     -------
@@ -178,6 +224,10 @@ def static_te_curves(case, torque: float | None = None, *, cracked: bool = False
     from ._version import __version__
     from .config import case_to_toml
 
+    _check_case(case)
+    if torque is not None:
+        torque = _quantity(torque, "torque", "torque")
+    centre_distance_change = _quantity(centre_distance_change, "length", "centre_distance_change")
     if stiffness_map is None:
         from .stiffness import build_map
 

@@ -128,7 +128,10 @@ def test_tooth_errors_use_the_static_centre_distance_geometry():
 def test_bad_model_names_are_refused():
     case = short_case(**{"simulation.record_time": 0.001})
     with pytest.raises(InputError, match="I-static"):
-        simulate(case, geometric_map(case.gear_pair()), model="i-static")  # the library is exact
+        simulate(case, geometric_map(case.gear_pair()), model="III")
+    # the model's name in any case, as the CLI's --model takes it
+    ds = simulate(case, geometric_map(case.gear_pair()), model="i-static")
+    assert ds.attrs["model"] == "I-static"
     with pytest.raises(InputError, match="simulation.model"):
         geardyn.paper_case({"simulation.model": "III"})
     assert geardyn.paper_case({"simulation.model": "I-static"}).simulation.model == "I-static"

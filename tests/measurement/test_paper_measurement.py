@@ -165,6 +165,12 @@ def test_drivers_and_detections_are_computed_from_the_variants():
     assert any("FM4" in t and "errors" in t for t in text)
     assert any(t.startswith("Crack seen (cracked / healthy > 1.5) on noise only by 1 of")
                for t in text)
+    # a fault that is not a crack is named as a fault (the data keep the key "cracked")
+    text = statements({"drivers": d, "detections": det}, ("faulty", "fault"))
+    assert any(t.startswith("Fault seen (faulty / healthy > 1.5) on noise only by 1 of")
+               for t in text)
+    assert any(t.startswith("Faulty pair, realistic record: ") for t in text)
+    assert not any("crack" in t.lower() for t in text)
 
 
 @pytest.mark.slow
@@ -263,7 +269,13 @@ def test_housing_statements_follow_the_numbers():
     hd["healthy"]["FM4"] = [None, 3.2]
     hd["not_computed"] = {"0.01": "too short"}
     (text,) = housing_statements(hd)
-    assert "1%: undefined" in text and "Not computed at 1%" in text and "at 5%" in text
+    # one word for it, in the sentence and in the report's table (NOT_COMPUTED)
+    assert "1%: not computed" in text and "Not computed at 1%" in text and "at 5%" in text
+    assert "undefined" not in text
+    # "not within 0.5 of 3" says why 3 matters
+    hd["healthy"]["FM4"] = [None, 4.0]
+    (text,) = housing_statements(hd)
+    assert "not within 0.5 of 3, the value of a Gaussian difference signal, at any" in text
     assert housing_statements({"skipped": "an FRF table"}) == [
         "Housing damping not varied: an FRF table."]
     assert housing_statements(None) == []

@@ -388,11 +388,16 @@ def test_model_comparison_recomputed_from_the_run_files(run_dir):
     assert "dashed: model I-static" in text
 
 
+#: A user's case with unequal gears (the QA walkthrough's 25/31 pair): --quick's own record
+#: length (long enough for the realistic-measurement stage, which SHORT's is not) and map.
+OWN = ["--quick", "--stiffness", "pem", "--set", "diagnostics.samples_per_rev=1024"]
+
+
 @pytest.fixture(scope="module")
 def own_case_dir(tmp_path_factory):
     out = tmp_path_factory.mktemp("own") / "out"
-    r = run_geardyn(["run", "--out", str(out), *SHORT,
-                     "--set", "pinion.teeth=25"],
+    r = run_geardyn(["run", "--out", str(out), *OWN,
+                     "--set", "pinion.teeth=25", "--set", "gear.teeth=31"],
                     capture_output=True, text=True, timeout=900)
     assert r.returncode == 0, r.stderr + r.stdout
     return out
@@ -402,7 +407,8 @@ def test_a_users_own_case_is_not_compared_with_the_paper(own_case_dir):
     out = own_case_dir
     s = json.loads((out / "summary.json").read_text())
     assert s["paper_case"] is False
-    assert s["differences_from_paper"] == [{"key": "pinion.teeth", "paper": 23, "case": 25}]
+    assert s["differences_from_paper"] == [{"key": "pinion.teeth", "paper": 23, "case": 25},
+                                           {"key": "gear.teeth", "paper": 23, "case": 31}]
     assert s["comparisons"] == [] and s["validation"] == []
     assert s["checks"] and not any("paper" in r["source"] for r in s["checks"])
     p = _Html()
@@ -416,6 +422,86 @@ def test_a_users_own_case_is_not_compared_with_the_paper(own_case_dir):
     assert "What differs from the paper's case" in text and "pinion.teeth" in text
     with xr.open_dataset(out / "results.nc", engine="h5netcdf") as root:
         assert "paper_table2" not in root.data_vars and "table2" in root.data_vars
+
+
+def test_own_case_realistic_record_is_reproduced_by_the_printed_commands(own_case_dir,
+                                                                          tmp_path):
+    """The report's geardyn measure / diagnose commands write this run's realistic records:
+    its case (case.toml, with --set and --stiffness), its quick map and record length; diagnose
+    reads the teeth from the file. Their FM4 is the report's."""
+    import re
+    import shlex
+
+    from geardyn.config import load_case
+
+    out = own_case_dir
+    s = json.loads((out / "summary.json").read_text())
+    written = load_case(out / "case.toml")
+    assert written.pinion.teeth == s["differences_from_paper"][0]["case"] == 25
+    assert written.gear.teeth == s["differences_from_paper"][1]["case"] == 31
+    assert written.stiffness.method == "pem"
+    text = _text(out)
+    m = re.search(r"\): (geardyn measure .*?--out healthy\.nc) and (geardyn measure .*?--out "
+                  r"faulty\.nc), then (geardyn diagnose .*?) and (geardyn diagnose .*?tach)\. ",
+                  text)
+    assert m, text[text.find("The same realistic records"):][:600]
+    cmds = m.groups()
+    assert all(f"-c {out / 'case.toml'}" in c for c in cmds)
+    assert "--teeth" not in text
+    for c in cmds:
+        r = run_geardyn(shlex.split(c)[1:], cwd=tmp_path, timeout=600)
+        assert r.returncode == 0, r.stderr + r.stdout
+    real = s["measurement"]["indicators"]["errors+noise"]
+    for name, state in (("healthy", "healthy"), ("faulty", "cracked")):
+        got = json.loads((tmp_path / f"{name}-diagnose" / "metrics.json").read_text())
+        fm4 = got["signals"]["acc"]["condition_metrics"]["FM4"]
+        assert fm4 == pytest.approx(real[state]["FM4"], rel=1e-9), name
+        assert f"{real[state]['FM4']:.4g} {state}" in text
+
+
+def test_own_case_report_and_results_say_what_the_run_computed(own_case_dir):
+    """Map grid from the map itself, the transmission error as the record defines it, the
+    shipped case's notes marked, one word for a value not computed, units in results.nc."""
+    out = own_case_dir
+    s = json.loads((out / "summary.json").read_text())
+    text = _text(out)
+    with xr.open_dataset(out / "results.nc", group="stiffness/healthy", engine="h5netcdf") as g:
+        dd = g["centre_distance_change"].values
+    assert (f"changes {dd[0] * 1e3:g} to {dd[-1] * 1e3:g} mm on {dd.size} grid lines"
+            in text)
+    with xr.open_dataset(out / "runs" / "model_II_cracked.nc", engine="h5netcdf") as ds:
+        te = ds["transmission_error"].attrs
+    formula = "theta_p - (r_b2/r_b1) theta_g"
+    assert formula in te["long_name"]
+    assert f"transmission error {formula} [{te['units']}]" in text
+    assert "theta_p - theta_g [" not in text
+    p = _Tables()
+    p.feed((out / "report.html").read_text())
+    tooth = [c for c in p.rows if len(c) == 3 and c[0][0] == "crack.tooth"]
+    assert tooth and tooth[0][2][0].endswith(
+        "[note of the shipped case, for its pinion.teeth = 23, gear.teeth = 23: not about this "
+        "case]")
+    hd = s["measurement"]["housing_damping"]
+    assert hd.get("not_computed")  # --quick's record is too short for the lightest damping
+    for z in hd["not_computed"]:
+        row = next(c for c in p.rows if len(c) == 7 and c[0][0] == f"{100 * float(z):g}")
+        assert [c for c, _ in row[2:]] == ["not computed"] * 5
+        assert f"{100 * float(z):g}%: not computed" in text
+    with xr.open_dataset(out / "results.nc", engine="h5netcdf") as root:
+        for name, v in root.variables.items():
+            if name in root.coords:
+                assert v.attrs.get("long_name"), name
+            else:
+                u = v.attrs.get("units")
+                assert u is None or " " not in u, (name, u)  # a unit, not prose
+                assert u is not None or v.attrs.get("units_coordinate") in root.coords, name
+        t2 = root["table2"].sel(signal="transmission_error", model="II")
+        assert t2.sel(statistic2="std")["statistic2_units"].item() == te["units"]
+        assert t2.sel(statistic2="kurtosis")["statistic2_units"].item() == "1"
+        t3 = root["table3"].sel(signal="transmission_error", model="II")
+        assert t3.sel(statistic3="pm_mean_deg")["statistic3_units"].item() == "deg"
+        assert t3.sel(statistic3="pm_mean_deg").item() == pytest.approx(
+            s["table3"]["transmission_error"]["II"]["pm_mean_deg"], rel=1e-15)
 
 
 def test_warm_rerun_uses_the_cache(run_dir, run_cache, tmp_path):

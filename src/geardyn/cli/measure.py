@@ -72,14 +72,20 @@ def measure(
 
     models = get_args(SimulationConfig.model_fields["model"].annotation)  # "I", "I-static", "II"
     model = choice("--model", model, models)  # before the case: a bad name fails at once
-    case = load_case_from_cli(config, set_)
+    if stiffness is not None and stiffness not in ("pem", "fe"):
+        raise InputError("--stiffness", stiffness, "'pem' or 'fe'")
+    from .simulate import case_with_options
+
+    # the options become the case's values (with their source): the record's case_toml is the
+    # case that was run, which measures the same when loaded again
+    case = case_with_options(load_case_from_cli(config, set_),
+                             {"stiffness.method": ("--stiffness", stiffness),
+                              "simulation.model": ("--model", model)})
     if not crack:  # the healthy pair: no faults at all (no wear gap either)
         from ..faults import without_faults
 
         case = without_faults(case)
-    which = case.simulation.model if model is None else model
-    if stiffness is not None and stiffness not in ("pem", "fe"):
-        raise InputError("--stiffness", stiffness, "'pem' or 'fe'")
+    which = case.simulation.model
     targets = [out] + ([out.with_suffix(".csv")] if csv else []) \
         + ([out.with_suffix(".mat")] if mat else [])
     refuse_overwrite(targets, force)
@@ -90,7 +96,7 @@ def measure(
         def tick(done: int, total: int) -> None:
             bar.update(task, completed=done, total=total)
 
-        smap = build_map(case, method=stiffness, cracked=crack, progress=tick)
+        smap = build_map(case, method=case.stiffness.method, cracked=crack, progress=tick)
         bar.update(task, description=f"model {which}", completed=0, total=None)
         result = run_measure(case, smap, model=which, cracked=crack, progress=tick)
     ds = result.record

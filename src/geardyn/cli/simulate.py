@@ -26,6 +26,18 @@ from ._common import (
 DEFAULT_OUT = Path("sim.nc")
 
 
+def case_with_options(case, options: dict[str, tuple[str, object]]):
+    """``case`` with the values of command-line options that override case values, each with
+    its option as the value's source: ``{"stiffness.method": ("--stiffness", "pem")}`` records
+    ``stiffness.method = "pem"`` from ``"--stiffness option"``. The record's stored case
+    (``case_toml``) is then the case that was run: loaded again it runs the same. An option not
+    given (None) leaves the case's value and source."""
+    for key, (option, value) in options.items():
+        if value is not None:
+            case = case.with_overrides({key: value}, source=f"{option} option")
+    return case
+
+
 def _recorded_identity(path: Path) -> tuple[dict | None, int | None]:
     """The inputs identity and ``complete`` flag a geardyn record carries (None if not one)."""
     import json
@@ -95,9 +107,13 @@ def simulate(
         raise OutputInUse(target.label, "is an existing file that is not a geardyn record "
                                         "of known inputs", "pass --force to replace it, or "
                                                           "choose another file with --out")
-    case = load_case_from_cli(config, set_)
-    which = model or case.simulation.model
-    method = stiffness or case.stiffness.method
+    # the options become the case's values (with their source): the stored case_toml is the
+    # effective case, which simulates the same when loaded again
+    case = case_with_options(load_case_from_cli(config, set_),
+                             {"stiffness.method": ("--stiffness", stiffness),
+                              "simulation.model": ("--model", model)})
+    which = case.simulation.model
+    method = case.stiffness.method
     check_step_count(case.simulation)  # a run that would not end is refused before the imports
 
     from ..dynamics import save_mat, save_netcdf, summary

@@ -71,9 +71,11 @@ def static_te(
     check_writable(target, folder=False)
     png = out.with_suffix(".png")
     refuse_overwrite([out, png], force)
-    case = load_case_from_cli(config, set_)
-    if method is not None:
-        case = case.with_overrides({"stiffness.method": method})
+    from .simulate import case_with_options
+
+    # the stored case_toml is the case that was run (the option recorded as the value's source)
+    case = case_with_options(load_case_from_cli(config, set_),
+                             {"stiffness.method": ("--stiffness", method)})
     tq = case.motor.torque if torque is None else to_si(torque, "torque", "--torque")
     if not (tq >= 0 and tq < float("inf")):
         raise InputError("--torque", torque, "a finite pinion torque >= 0 [N m]")

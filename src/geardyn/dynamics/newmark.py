@@ -160,7 +160,10 @@ def make_setup(M, K0, C, g, Q0, stiffness_map: StiffnessMap | MapArrays, *, dt: 
     drive : (gain, w_ref, times, speeds), optional
         Speed-controlled drive: adds ``gain (w_target(t) - w_ref)`` [N m] to DOF 0, with
         ``w_target`` piecewise linear in ``(times [s], speeds [rad/s])``; the drive's slope
-        ``-gain`` must already be in ``C[0, 0]``.
+        ``-gain`` must already be in ``C[0, 0]``. With it the input torque is
+        ``T_in(w_m) + gain (w_target(t) - w_m)``: proportional control without integral action,
+        so a steady state differs from a constant target by ``(T_needed(w) - T_in(w)) / gain``
+        (``T_needed``: the load and loss torque at the motor), not zero.
     stiffness_window : {"step", "point"}
         ``"step"`` (default): the map averaged over each step's rotation
         (:func:`geardyn.stiffness.map.lookup_box`), so a contact handover inside a step enters
@@ -410,6 +413,14 @@ def fixed_distance_arrays(stiffness_map: StiffnessMap, centre_distance_change: f
 def _speed_profile(case, dyn: DynamicModel):
     """``(gain, w_ref, times, speeds)`` of the case's speed-controlled drive, or None.
 
+    The drive adds ``gain (w_target(t) - w_m)`` to the input law's torque ``T_in(w_m)``
+    (``case.motor.torque`` for the constant law): a proportional controller without integral
+    action. In a steady state at a constant target ``w_1`` the motor turns at the speed ``w``
+    where ``T_in(w) + gain (w_1 - w)`` equals the torque the load and the losses need, i.e.
+    below a target above the starting speed by ``(T_needed(w) - T_in(w)) / gain`` (the paper's
+    case ramped to 150 rad/s with gain 5 N m s/rad settles near 144.6 rad/s); a larger gain
+    makes the error smaller.
+
     Raises
     ------
     InputError
@@ -494,16 +505,16 @@ def simulate(case, stiffness_map: StiffnessMap | None = None, *, model: str | No
     Raises
     ------
     InputError
-        Bad model name, a time step too coarse for the highest natural frequency, a map not
-        covering the operating point, load laws without a steady state.
+        ``case`` not a :class:`geardyn.config.Case`, ``stiffness_map`` neither a
+        :class:`geardyn.stiffness.StiffnessMap` nor None, an unknown model name (any case is
+        accepted, as by the CLI's ``--model``), a time step too coarse for the highest natural
+        frequency, a map not covering the operating point, load laws without a steady state.
     NumericalError
         Divergence (NaN, runaway deflection), the centre distance leaving the map, or the model II
         iteration not converging. The record up to the failure is attached as ``exc.partial``
         (attribute ``complete = 0``).
     """
-    which = case.simulation.model if model is None else model
-    if which not in MODELS:
-        raise InputError("model", which, ", ".join(repr(m) for m in MODELS))
+    which = check_arguments(case, stiffness_map, model)
     if case.simulation.dynamics == "transverse":
         from .transverse import simulate_transverse
 
@@ -543,6 +554,41 @@ def simulate(case, stiffness_map: StiffnessMap | None = None, *, model: str | No
     if status != K.OK:
         raise_with_partial(status, fail, which, static, stiffness_map, record)
     return record(True)
+
+
+def check_arguments(case, stiffness_map, model) -> str:
+    """Check the arguments of :func:`simulate` and return the model's name as in :data:`MODELS`
+    (``model`` matched in any case, as the CLI's ``--model``; None: ``case.simulation.model``).
+
+    Raises
+    ------
+    InputError
+        Naming the argument: ``case`` not a :class:`geardyn.config.Case`, ``stiffness_map``
+        neither a :class:`geardyn.stiffness.StiffnessMap` nor None, ``model`` not a model name.
+    """
+    from ..config import Case
+
+    if not isinstance(case, Case):
+        raise InputError("case", case, "a geardyn.config.Case (geardyn.load_case(path) or "
+                                       f"geardyn.paper_case()), not {_type_name(case)}")
+    if stiffness_map is not None and not isinstance(stiffness_map, StiffnessMap):
+        raise InputError("stiffness_map", stiffness_map,
+                         "a geardyn.stiffness.StiffnessMap (geardyn.stiffness.build_map(case)), "
+                         f"or None to build the case's map; not {_type_name(stiffness_map)}")
+    which = case.simulation.model if model is None else model
+    if isinstance(which, str):
+        for name in MODELS:
+            if which.strip().lower() == name.lower():
+                return name
+    raise InputError("model", which, " or ".join(repr(m) for m in MODELS) + " (any case), or "
+                     "None for the case's simulation.model")
+
+
+def _type_name(value) -> str:
+    """``"a <module>.<type>"`` of ``value`` for an error message."""
+    t = type(value)
+    return f"a {t.__qualname__}" if t.__module__ == "builtins" else \
+        f"a {t.__module__}.{t.__qualname__}"
 
 
 @contextmanager
@@ -721,6 +767,11 @@ _VARS = (
 )
 
 
+#: Units of the damping values of :attr:`DynamicModel.damping` (the record's ``damping``).
+_DAMPING_UNITS = {"q_cp": "N m s/rad", "q_cg": "N m s/rad", "q_yp": "N s/m", "q_yg": "N s/m",
+                  "q_stp": "N m s/rad", "q_stg": "N m s/rad", "q_mb": "N s/m"}
+
+
 def _dataset(case, dyn: DynamicModel, stiffness_map: StiffnessMap, which: str,
              static: StaticState, setup: KernelSetup, rows: np.ndarray, n_settle: int,
              decim: int, complete: bool):
@@ -795,26 +846,32 @@ def _dataset(case, dyn: DynamicModel, stiffness_map: StiffnessMap, which: str,
         "pinion_teeth": int(dyn.pair.pinion.teeth),
         "gear_teeth": int(dyn.pair.gear.teeth),
         "dt": float(dt), "dt_units": "s",
-        "settle_time": float(n_settle * dt), "record_time": float(sim.record_time),
+        "settle_time": float(n_settle * dt), "settle_time_units": "s",
+        "record_time": float(sim.record_time), "record_time_units": "s",
         "decimation": int(decim),
         "integrator": sim.integrator,
         "contact_ratio_formula": sim.contact_ratio_formula,
         "hht_alpha": float(sim.hht_alpha if sim.integrator == "hht" else 0.0),
+        "hht_alpha_units": "1",
         "stiffness_evaluation": sim.stiffness_evaluation,
         "stiffness_window": sim.stiffness_window,
         "tolerance": float(sim.tolerance), "tolerance_units": "m",
-        "rtol": float(sim.rtol), "max_iterations": int(sim.max_iterations),
+        "rtol": float(sim.rtol), "rtol_units": "1", "max_iterations": int(sim.max_iterations),
         "target_speed": float(dyn.speed), "target_speed_units": "rad/s",
         "input_law": dyn.input_law.describe(),
         "output_law": dyn.output_law.describe(),
         "output_law_calibrated": int(dyn.output_calibrated),
         "mesh_damping": float(dyn.q_mb), "mesh_damping_units": "N s/m",
         "representative_mesh_stiffness": float(dyn.k_rep),
-        "damping": "; ".join(f"{k} = {v:.6g}" for k, v in dyn.damping.items()),
-        "static_mesh_force": float(static.mesh_force),
+        "representative_mesh_stiffness_units": "N/m",
+        "damping": "; ".join(f"{k} = {v:.6g} {_DAMPING_UNITS.get(k, '(SI)')}"
+                             for k, v in dyn.damping.items()),
+        "static_mesh_force": float(static.mesh_force), "static_mesh_force_units": "N",
         "static_centre_distance_change": float(static.centre_distance_change),
-        "highest_natural_frequency": float(f_max), "mesh_frequency": float(f_mesh),
-        "max_time_step": float(dt_max),
+        "static_centre_distance_change_units": "m",
+        "highest_natural_frequency": float(f_max), "highest_natural_frequency_units": "Hz",
+        "mesh_frequency": float(f_mesh), "mesh_frequency_units": "Hz",
+        "max_time_step": float(dt_max), "max_time_step_units": "s",
         "stiffness_method": str(mattrs.get("method", "")),
         "stiffness_inputs_hash": str(mattrs.get("inputs_hash", "")),
         "stiffness_cracked": int(bool(mattrs.get("cracked", 0))),
@@ -857,13 +914,33 @@ def _dataset(case, dyn: DynamicModel, stiffness_map: StiffnessMap, which: str,
             + " N m), read at each step's elastic mesh force, linear between them")
     if setup.fp[K.FP_DRIVE_GAIN] != 0.0:
         tp, wp = setup.speed_profile
+        gain = float(setup.fp[K.FP_DRIVE_GAIN])
         attrs["speed_profile"] = (
-            f"speed-controlled drive, gain {setup.fp[K.FP_DRIVE_GAIN]:.6g} N m s/rad, target "
-            + ", ".join(f"{w:.6g} rad/s at {t:.6g} s" for t, w in zip(tp, wp, strict=True)))
+            f"speed-controlled drive (proportional), gain {gain:.6g} N m s/rad, target "
+            + ", ".join(f"{w:.6g} rad/s at {t:.6g} s" for t, w in zip(tp, wp, strict=True))
+            + " (linear between, constant beyond the ends)")
+        # what was simulated: the input law plus the controller; the target is the profile's
+        # (its final speed), not the steady speed of the input law the run starts from
+        attrs["input_law"] = (
+            f"{dyn.input_law.describe()} + {gain:.6g} N m s/rad x (w_target(t) - w_m): "
+            f"proportional speed control without integral action to the speed_profile target "
+            f"(final {float(wp[-1]):.6g} rad/s); a steady state misses a constant target by "
+            f"w_target - w = (load and loss torque at the motor - T_in(w)) / {gain:.6g} "
+            f"N m s/rad")
+        attrs["target_speed"] = float(wp[-1])
+        attrs["target_speed_meaning"] = (
+            f"final target of the speed_profile (from {float(tp[-1]):.6g} s on); the proportional "
+            f"drive settles off it (see input_law)")
+        attrs["initial_speed"] = float(dyn.speed)
+        attrs["initial_speed_units"] = "rad/s"
+        attrs["initial_speed_meaning"] = (
+            "steady pinion speed of the input and load laws without the drive: the static "
+            "equilibrium the run starts from, and the speed of the reference rotation")
     if setup.fp[K.FP_RIP_AMP] != 0.0:
         attrs["input_torque_ripple"] = (
             f"{setup.fp[K.FP_RIP_AMP]:.6g} N m x sin({setup.fp[K.FP_RIP_ORDER]:.6g} theta_ref + "
-            f"{setup.fp[K.FP_RIP_PHASE]:.6g} rad), theta_ref = target speed x time")
+            f"{setup.fp[K.FP_RIP_PHASE]:.6g} rad), theta_ref = {float(dyn.speed):.6g} rad/s x "
+            f"time")
     if tooth_errors:
         from ..modifications import ToothModifications
 

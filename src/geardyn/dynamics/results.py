@@ -37,7 +37,9 @@ def save_mat(ds, path: str | os.PathLike) -> None:
                     for k, v in ds.attrs.items()}
     with atomic_path(path, suffix=".mat") as tmp:
         with open(tmp, "wb") as fh:
-            savemat(fh, out, do_compression=True, oned_as="column")
+            # long_field_names: attribute names such as static_centre_distance_change_units
+            # pass MATLAB 5's 31 characters (MATLAB 7.6+ reads up to 63)
+            savemat(fh, out, do_compression=True, oned_as="column", long_field_names=True)
 
 
 def summary(ds) -> dict[str, float]:

@@ -520,20 +520,18 @@ def simulate_transverse(case, stiffness_map: StiffnessMap | None = None, *,
     InputError, NumericalError
         As :func:`geardyn.dynamics.simulate`; also HHT or a load family with this model.
     """
-    from .model import MODELS
     from .newmark import (
         CHUNK_STEPS,
         _start_with_errors,
         case_arithmetic,
+        check_arguments,
         check_bounded_work,
         drive_chunks,
         raise_with_partial,
         record_plan,
     )
 
-    which = case.simulation.model if model is None else model
-    if which not in MODELS:
-        raise InputError("model", which, ", ".join(repr(m) for m in MODELS))
+    which = check_arguments(case, stiffness_map, model)  # a model name in any case
     check_bounded_work(case)
     _refuse_unsupported(case)
     if stiffness_map is None:
@@ -652,6 +650,7 @@ def transverse_dataset(case, setup: TransverseSetup, stiffness_map: StiffnessMap
         "dynamics": "transverse",
         "centres": "x and y free" if tm.x_free else "held on the design line of action (x = 0)",
         "friction_coefficient": float(tm.friction_coefficient),
+        "friction_coefficient_units": "1",
         "friction_rule": "Coulomb, mu N_k per pair by the map's load shares (equal without "
                          "them), sign changes at the pitch point, averaged over the step's roll",
     })

@@ -113,4 +113,4 @@ def write_mat(ds, path: str | os.PathLike) -> None:
     out["attrs"] = {k: (v if isinstance(v, str | int | float) else str(v))
                     for k, v in ds.attrs.items()}
     with atomic_path(Path(path), suffix=".mat") as tmp, open(tmp, "wb") as fh:
-        savemat(fh, out, do_compression=True, oned_as="column")
+        savemat(fh, out, do_compression=True, oned_as="column", long_field_names=True)

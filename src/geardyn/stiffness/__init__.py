@@ -107,10 +107,14 @@ def build_map(case, *, method: str | None = None, cracked: bool = True,
         revolution, or one gear revolution for a crack on the gear (``StiffnessMap.period``).
     """
     from ..cache import cache_key, default_cache
+    from ..config import Case
     from ..errors import InputError
 
+    if not isinstance(case, Case):
+        raise InputError("case", case, "a geardyn.config.Case (geardyn.load_case(path) or "
+                                       "geardyn.paper_case())")
     method = method or case.stiffness.method
-    if method not in MODEL_VERSIONS:
+    if not isinstance(method, str) or method not in MODEL_VERSIONS:
         raise InputError("stiffness.method", method, "'pem' or 'fe'")
     if cracked:  # a method that cannot model a fault of the case says so (geardyn.faults)
         from ..faults import check_method

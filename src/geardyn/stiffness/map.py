@@ -272,6 +272,31 @@ def lookup_box_reference(theta: float, h: float, dd: float, arrays: MapArrays) -
     return ((tb - lo) * vl + (hi - tb) * vr) / (2.0 * h)
 
 
+def _count(value, field_name: str, minimum: int) -> int:
+    """``value`` as an int >= ``minimum`` (Python or NumPy integer, not a bool), or
+    :class:`InputError` naming ``field_name``."""
+    if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < minimum:
+        raise InputError(field_name, value, f"a whole number >= {minimum}")
+    return int(value)
+
+
+def _real_array(value, field_name: str, allowed: str) -> np.ndarray:
+    """``value`` as a float array (numbers only: a string, ``None`` or a bool is refused)."""
+    arr = np.asarray(value)
+    if arr.dtype.kind not in "fiu":
+        raise InputError(field_name, value, allowed)
+    return arr.astype(float, copy=False)
+
+
+def _not_numbers(value) -> bool:
+    """Whether NumPy cannot read ``value`` as a float array."""
+    try:
+        np.asarray(value, float)
+    except (TypeError, ValueError):
+        return True
+    return False
+
+
 def zone_boundaries(pair, dd: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Geometric exit phase ``a`` and zone-A length for each centre distance change.
 
@@ -345,6 +370,8 @@ class StiffnessMap:
     attrs: Mapping[str, object] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
+        _count(self.n_seg, "n_seg", 2)
+        _count(self.n_cycles, "n_cycles", 1)
         dd = np.asarray(self.dd, float)
         if dd.ndim != 1 or dd.size < 1:
             raise InputError("dd", self.dd, "a 1-D array of centre distance changes [m]")
@@ -407,16 +434,17 @@ class StiffnessMap:
             "pairs_in_contact": (n,), "transmission_error": (n,)}`` for pinion angles ``theta``
             [rad] at the change ``dd`` [m].
         n_cycles : int, optional
-            Mesh cycles in the period; default ``z1`` (one pinion revolution).
+            Mesh cycles in the period (>= 1); default ``z1`` (one pinion revolution).
         n_seg : int
-            Nodes per contact zone.
+            Nodes per contact zone (>= 2: the two end nodes hold the one-sided limits).
         attrs : mapping, optional
             Provenance to store.
         progress : callable, optional
             ``progress(done, total)`` after each grid line.
         """
-        dd = np.atleast_1d(np.asarray(dd, float))
-        n_cycles = pair.pinion.teeth if n_cycles is None else int(n_cycles)
+        n_seg = _count(n_seg, "n_seg", 2)
+        n_cycles = pair.pinion.teeth if n_cycles is None else _count(n_cycles, "n_cycles", 1)
+        dd = np.atleast_1d(_real_array(dd, "dd", "centre distance changes [m] (numbers)"))
         pa, la = zone_boundaries(pair, dd)
         tm = pair.mesh_angle
         rows: dict[str, list[np.ndarray]] = {}
@@ -453,8 +481,9 @@ class StiffnessMap:
         dd : array_like, optional
             Centre distance changes of the rows [m]; omit for one row (constant in ``d``).
         n_seg : int
-            Nodes per contact zone of the resampled map.
+            Nodes per contact zone of the resampled map (>= 2).
         """
+        n_seg = _count(n_seg, "n_seg", 2)
         theta = np.asarray(theta, float)
         k2 = np.atleast_2d(np.asarray(k_mb, float))
         if theta.ndim != 1 or theta.size < 4 or np.any(np.diff(theta) <= 0):
@@ -488,8 +517,21 @@ class StiffnessMap:
     def arrays(self, variable: str = "k_mb", slot: int | None = None) -> MapArrays:
         """The plain arrays for :func:`lookup` (``variable``: ``"k_mb"`` or an ``extra`` name
         with one value per node; ``slot`` picks one column of ``load_share``)."""
-        vals = self.k_mb if variable == "k_mb" else self.extra[variable]
-        if slot is not None:
+        if variable == "k_mb":
+            vals = self.k_mb
+        elif isinstance(variable, str) and variable in self.extra:
+            vals = self.extra[variable]
+        else:
+            raise InputError("variable", variable,
+                             "one of " + ", ".join(repr(v) for v in ["k_mb", *self.extra]))
+        if slot is not None and vals.ndim == 2:
+            raise InputError("slot", slot, f"None for {variable!r} (one value per node)")
+        if slot is not None and vals.ndim == 3:
+            n_slots = vals.shape[-1]
+            if isinstance(slot, bool) or not isinstance(slot, int | np.integer) \
+                    or not 0 <= slot < n_slots:
+                raise InputError("slot", slot, f"an integer in [0, {n_slots - 1}] (a slot of "
+                                               f"{variable!r})")
             vals = vals[..., slot]
         if vals.ndim != 2:
             raise InputError("variable", variable, "a variable with one value per node")
@@ -504,10 +546,35 @@ class StiffnessMap:
 
         Returns ``k_mb`` [N/m] by default; NaN outside the centre-distance range.
         ``variable="load_share", slot=k`` gives the share of slot ``k`` (see ``slot_tooth``).
+
+        Raises
+        ------
+        InputError
+            ``theta`` or ``dd`` not numbers (or arrays of them), a non-finite ``theta``, shapes
+            that do not broadcast, an unknown ``variable`` or ``slot``.
         """
         arr = self.arrays(variable, slot)
-        th, d = np.broadcast_arrays(np.asarray(theta, float), np.asarray(dd, float))
-        out = _lookup_many(th.ravel(), d.ravel(), *arr)
+        # cheap checks only (a hot path): what numpy cannot read as numbers and None (which it
+        # reads as NaN) are refused here, a non-finite theta by the kernel's loop
+        try:
+            th = None if theta is None else np.asarray(theta, float)
+            d = None if dd is None else np.asarray(dd, float)
+        except (TypeError, ValueError):
+            th = d = None
+        if th is None or d is None:
+            if theta is None or _not_numbers(theta):
+                raise InputError("theta", theta, "pinion angles [rad]: a number or an array of "
+                                                 "them")
+            raise InputError("dd", dd, "centre distance changes [m]: a number or an array of "
+                                       "them")
+        try:
+            th, d = np.broadcast_arrays(th, d)
+        except ValueError:
+            raise InputError("dd", f"shape {d.shape}",
+                             f"a shape that broadcasts with theta's {th.shape}") from None
+        out, bad = _lookup_many(th.ravel(), d.ravel(), *arr)
+        if bad >= 0:
+            raise InputError("theta", float(th.ravel()[bad]), "finite pinion angles [rad]")
         return out.reshape(th.shape) if th.shape else float(out[0])
 
     def torsional(self, theta, dd=0.0) -> np.ndarray:
@@ -615,10 +682,16 @@ class StiffnessMap:
         return cls.from_dataset(ds)
 
     def regular(self, n_theta: int = 360, dd: np.ndarray | None = None):
-        """The map resampled on a regular ``(dd, theta)`` grid, as an xarray DataArray [N/m]."""
+        """The map resampled on a regular ``(dd, theta)`` grid, as an xarray DataArray [N/m].
+
+        ``n_theta`` (>= 1) angles over one period; ``dd`` the centre distance changes [m]
+        (default: the map's grid lines).
+        """
         import xarray as xr
 
-        dd = self.dd if dd is None else np.atleast_1d(np.asarray(dd, float))
+        n_theta = _count(n_theta, "n_theta", 1)
+        dd = self.dd if dd is None else np.atleast_1d(
+            _real_array(dd, "dd", "centre distance changes [m] (numbers)"))
         th = np.linspace(0.0, self.period, n_theta, endpoint=False)
         vals = self(th[None, :], dd[:, None])
         return xr.DataArray(vals, dims=("centre_distance_change", "theta"),
@@ -631,11 +704,19 @@ class StiffnessMap:
 
 @numba.njit(cache=True, nogil=True, fastmath=False)
 def _lookup_many(theta, dd, dd0, ddd, phase_a, length_a, mesh_angle, n_cycles, n_seg, values):
+    """:func:`lookup` at each ``(theta[k], dd[k])``; also the index of the first non-finite
+    ``theta`` (-1 if none), which is not looked up (its cell index would be undefined)."""
     out = np.empty(theta.size)
+    first_bad = -1
     for k in range(theta.size):
+        if not math.isfinite(theta[k]):
+            out[k] = np.nan
+            if first_bad < 0:
+                first_bad = k
+            continue
         out[k] = lookup(theta[k], dd[k], dd0, ddd, phase_a, length_a, mesh_angle, n_cycles,
                         n_seg, values)
-    return out
+    return out, first_bad
 
 
 def slot_teeth(pair, phase_a: float, n_cycles: int) -> np.ndarray:

@@ -22,7 +22,8 @@ __all__ = ["SIGNALS", "fig8_design_parameters", "fig9_iteration", "fig10_stiffne
 SIGNALS = {
     "v_yg": ("output gear vertical velocity", "m/s", r"$\dot y_g$"),
     "omega_p": ("input pinion angular velocity", "rad/s", r"$\dot\theta_p$"),
-    "transmission_error": ("transmission error", "rad", r"$\theta_p - \theta_g$"),
+    "transmission_error": ("transmission error", "rad",
+                           r"$\theta_p - (r_{b2}/r_{b1})\,\theta_g$"),
 }
 MODELS = ("I", "II")
 COLORS = {"I": "#1f77b4", "II": "#d62728", "I-static": "#2ca02c"}

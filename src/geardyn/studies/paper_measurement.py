@@ -47,7 +47,8 @@ from .paper_values import CONDITION_METRICS
 
 __all__ = ["DEFAULT_ERRORS", "DEFAULT_ERRORS_SOURCE", "VARIANTS", "INDICATORS",
            "HOUSING_DAMPING", "measurement_stage", "measured_indicators", "drivers",
-           "detections", "housing_damping_sweep", "MEASUREMENT_CACHE_VERSION"]
+           "detections", "housing_damping_sweep", "MEASUREMENT_CACHE_VERSION",
+           "reproduce_commands", "NOT_COMPUTED"]
 
 #: Tooth errors of the realistic record when the case has none: ISO 1328-1:2013 flank
 #: tolerance class 6 on both gears (the issue's proposed default), drawn with the seeds of
@@ -499,10 +500,13 @@ def _fmt(v) -> str:
     return "undefined" if v is None or not math.isfinite(v) else f"{v:.3g}"
 
 
-def statements(data: dict) -> list[str]:
+def statements(data: dict, words: tuple[str, str] = ("cracked", "crack")) -> list[str]:
     """The section's conclusions in words, computed from ``summary["measurement"]``: which
     input drives each indicator of the realistic record, healthy and cracked, and which
-    indicators see the crack in each variant."""
+    indicators see the crack in each variant. ``words``: the report's adjective and noun for
+    the faulty state (``("faulty", "fault")`` when the fault is not a crack); the data keep
+    the key ``"cracked"``."""
+    faulty, fault = words
     if "skipped" in data:
         return []
     labels = {k: lab for k, lab, _ in INDICATORS}
@@ -526,16 +530,17 @@ def statements(data: dict) -> list[str]:
             f"{_fmt(drv[state][k]['ideal'])}, errors only {_fmt(drv[state][k]['errors'])}, "
             f"noise only {_fmt(drv[state][k]['noise'])})"
             for k in ("FM4", "NA4star", "EnergyRatio") if k in drv[state])
-        out.append(f"{state.capitalize()} pair, realistic record: " + "; ".join(parts)
+        out.append(f"{state.replace('cracked', faulty).capitalize()} pair, realistic record: "
+                   + "; ".join(parts)
                    + f". {key}.")
     er_err_h = drv["healthy"].get("EnergyRatio", {}).get("errors")
     er_noise_c = drv["cracked"].get("EnergyRatio", {}).get("noise")
     if er_err_h is not None and er_noise_c is not None:
         cmp = "larger" if er_err_h > er_noise_c else "smaller"
         out.append(f"The tooth errors alone give the healthy pair an energy ratio of "
-                   f"{_fmt(er_err_h)}, {cmp} than the cracked pair's without errors "
+                   f"{_fmt(er_err_h)}, {cmp} than the {faulty} pair's without errors "
                    f"({_fmt(er_noise_c)}, noise only): the errors' difference signal is "
-                   f"{cmp} than the crack's.")
+                   f"{cmp} than the {fault}'s.")
     out += housing_statements(data.get("housing_damping"))
     det = data["detections"]
     names = {"ideal": "the ideal record", "errors": "tooth errors only",
@@ -544,20 +549,24 @@ def statements(data: dict) -> list[str]:
         seen = sorted(((r["ratio"], labels[k]) for k, r in det[name].items() if r["detected"]),
                       reverse=True)
         if seen:
-            out.append(f"Crack seen (cracked / healthy > {DETECTION_RATIO:g}) on {names[name]} by "
+            out.append(f"{fault.capitalize()} seen ({faulty} / healthy > {DETECTION_RATIO:g}) "
+                       f"on {names[name]} by "
                        f"{len(seen)} of {len(det[name])} indicators, strongest first: "
                        + ", ".join(f"{lab} x{r:.3g}" for r, lab in seen) + ".")
         else:
             best = max(((r["ratio"], labels[k]) for k, r in det[name].items()
                         if r["ratio"] is not None), default=None)
-            out.append(f"Crack seen on {names[name]} by none of the indicators"
-                       + (f" (largest cracked / healthy: {best[1]} x{best[0]:.3g})." if best
+            out.append(f"{fault.capitalize()} seen on {names[name]} by none of the indicators"
+                       + (f" (largest {faulty} / healthy: {best[1]} x{best[0]:.3g})." if best
                           else "."))
     return out
 
 
 #: FM4 within this of 3 counts as "near 3" (a Gaussian difference signal) in the statements [-].
 GAUSSIAN_FM4_BAND = 0.5
+
+#: The word for a housing-damping value the record is too short to compute (table and text).
+NOT_COMPUTED = "not computed"
 
 
 def housing_statements(hd: dict | None) -> list[str]:
@@ -569,8 +578,11 @@ def housing_statements(hd: dict | None) -> list[str]:
     ratio = hd["decay_over_mesh_period"]
     near = [i for i, v in enumerate(fm) if math.isfinite(v) and abs(v - 3) <= GAUSSIAN_FM4_BAND]
     own = ", ".join(f"{100 * v:g}%" for v in sorted(set(hd["case_damping_ratios"])))
+    skipped = {f"{float(k):g}" for k in hd.get("not_computed", {})}
     text = ("Healthy FM4 of the realistic record with every housing mode's damping ratio set to "
-            + ", ".join(f"{100 * a:g}%: {_fmt(b)}" for a, b in zip(z, fm, strict=True))
+            + ", ".join(f"{100 * a:g}%: "
+                        + (NOT_COMPUTED if f"{a:g}" in skipped else _fmt(b))
+                        for a, b in zip(z, fm, strict=True))
             + f" (this case's path: {own}; the lowest mode's decay time 1 / (zeta 2 pi f) is "
             f"{ratio[-1]:.2g} to {ratio[0]:.2g} mesh periods over that range). ")
     if hd.get("not_computed"):
@@ -585,6 +597,56 @@ def housing_statements(hd: dict | None) -> list[str]:
                  + " mesh periods); the tooth errors' transients of successive meshes overlap "
                  "there, while a more damped path leaves them isolated and impulsive.")
     else:
-        text += (f"FM4 is not within {GAUSSIAN_FM4_BAND:g} of 3 at any of these damping "
-                 "ratios.")
+        text += (f"FM4 is not within {GAUSSIAN_FM4_BAND:g} of 3, the value of a Gaussian "
+                 "difference signal, at any of these damping ratios"
+                 + (" where it was computed" if skipped else "")
+ + ": the healthy difference signal is not Gaussian-like at any of them.")
     return [text]
+
+
+def reproduce_commands(case_file: str, case: Case, sim_case: Case, map_case: Case,
+                       record_s: float) -> dict:
+    """``geardyn measure`` and ``geardyn diagnose`` command lines that write this stage's
+    realistic records (errors + noise) as files and diagnose them.
+
+    Parameters
+    ----------
+    case_file : str
+        The run's ``case.toml`` (the effective case: case file, ``--set`` overrides and the
+        stiffness method), as the command line shall name it.
+    case, sim_case, map_case : Case
+        The study's case, the case its simulations ran (shorter with ``--quick``) and the one
+        its stiffness maps were built from (coarser with ``--quick``).
+    record_s : float
+        Length of the stage's measured record [s] (``geardyn measure`` measures
+        ``simulation.record_time``; the stage measured its simulated record less the chain's
+        lead-in and tail).
+
+    Returns
+    -------
+    dict
+        ``healthy``, ``faulty`` (``geardyn measure``), ``diagnose_healthy``,
+        ``diagnose_faulty`` (``geardyn diagnose``): shell command lines; ``own_errors``: whether
+        the case's own ``[modifications]`` are the tooth errors.
+    """
+    import shlex
+
+    sets = []
+    if map_case.stiffness.centre_distances != case.stiffness.centre_distances:
+        sets.append(f"stiffness.centre_distances={map_case.stiffness.centre_distances}")
+    if map_case.stiffness.fe.refinement != case.stiffness.fe.refinement:
+        sets.append(f"stiffness.fe.refinement={map_case.stiffness.fe.refinement:g}")
+    if sim_case.simulation.settle_time != case.simulation.settle_time:
+        sets.append(f"simulation.settle_time={sim_case.simulation.settle_time:.12g} s")
+    sets.append(f"simulation.record_time={record_s:.12g} s")
+    _, err, _ = _variant_cases(case, sim_case)
+    own = err is sim_case
+    if not own:
+        sets += [f"{k}={v}" for k, v in DEFAULT_ERRORS.items()]
+    base = ["geardyn", "measure", "-c", case_file, *(x for s in sets for x in ("--set", s))]
+    diag = ["-c", case_file, "--signal", "acc", "--tach", "tach"]
+    return {"healthy": shlex.join([*base, "--no-crack", "--out", "healthy.nc"]),
+            "faulty": shlex.join([*base, "--out", "faulty.nc"]),
+            "diagnose_healthy": shlex.join(["geardyn", "diagnose", "healthy.nc", *diag]),
+            "diagnose_faulty": shlex.join(["geardyn", "diagnose", "faulty.nc", *diag]),
+            "own_errors": own}

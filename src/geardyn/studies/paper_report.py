@@ -148,6 +148,77 @@ def _case_rows(case: Case) -> list[tuple[str, str, str]]:
     return rows
 
 
+_GEOMETRY_KEYS = ("pinion.teeth", "gear.teeth", "pair.module", "pair.pressure_angle",
+                  "pair.addendum_coefficient", "pair.dedendum_coefficient",
+                  "pinion.profile_shift", "gear.profile_shift")
+
+#: Source notes of the shipped case that state numbers computed for its inputs, by key: the
+#: inputs (key prefixes) they were computed from. Off that case, a note whose inputs changed is
+#: shown as the shipped case's, not as a fact of this case (:func:`_case_table_rows`).
+SHIPPED_NOTE_INPUTS = {
+    "pair.face_width": (*_GEOMETRY_KEYS, "pair.face_width", "material."),
+    "pinion.profile_shift": _GEOMETRY_KEYS,
+    "pinion.bore_radius": (*_GEOMETRY_KEYS, "pinion.bore_radius"),
+    "pinion.bearing_damping_ratio": ("pinion.mass", "pinion.bearing_stiffness"),
+    "load.speed": ("motor.torque", "load.speed"),
+    "crack.enabled": ("crack.", "faults"),
+    "crack.gear": ("crack.", "faults"),
+    "crack.tooth": (*_GEOMETRY_KEYS, "crack.", "faults"),
+    "stiffness.foundation_half_angle": ("pinion.teeth", "gear.teeth"),
+    "simulation.dt": ("pinion.teeth", "load.speed", "simulation.dt"),
+    "simulation.record_time": ("load.speed", "simulation.record_time"),
+    "measurement.fs": ("pinion.teeth", "load.speed", "simulation.dt", "measurement.fs"),
+    "measurement.tach_jitter": ("load.speed",),
+}
+
+
+def _case_table_rows(case: Case, changed: list[str]) -> list[tuple[str, str, str]]:
+    """:func:`_case_rows` as the report shows them: a section switched off (``enabled =
+    false``) says its values are not used, and a note carried over from the shipped case whose
+    inputs ``changed`` (keys of the differences from it) is marked as the shipped case's, with
+    the shipped values it was written for."""
+    from ..config import paper_case
+
+    ref_case = paper_case()
+    ref = {k: (v, s) for k, v, s in _case_rows(ref_case)}
+    rows = _case_rows(case)
+    off = {k.rsplit(".", 1)[0] for k, v, _ in rows
+           if k.endswith(".enabled") and v == "False"}
+    out = []
+    for key, value, source in rows:
+        section = key.rsplit(".", 1)[0]
+        if section in off and not key.endswith(".enabled"):
+            source = f"not used ({section}.enabled = false); value from: {source}"
+        elif key in SHIPPED_NOTE_INPUTS and ref.get(key, (None, None))[1] == source:
+            hit = [c for c in changed
+                   if any(c == p or (p.endswith(".") and c.startswith(p))
+                          for p in SHIPPED_NOTE_INPUTS[key])]
+            if hit:
+                was = ", ".join(f"{c} = {_short_value(_get(ref_case, c))}" for c in hit)
+                source = f"{source} [note of the shipped case, for its {was}: not about this case]"
+        out.append((key, value, source))
+    return out
+
+
+def _get(case: Case, key: str):
+    """The value of a dotted key of ``case`` (None where absent)."""
+    node = case
+    for part in key.split("."):
+        node = getattr(node, part, None)
+        if node is None:
+            return None
+    if isinstance(node, list):
+        return [v.model_dump() if hasattr(v, "model_dump") else v for v in node]
+    return node
+
+
+def _faulty_words(case: Case) -> tuple[str, str]:
+    """``(adjective, noun)`` of the faulty state of the report: ("cracked", "crack") when the
+    case's fault is its crack alone, else ("faulty", "fault"). summary.json, results.nc and the
+    runs/ files keep the key "cracked" for that state whatever the fault."""
+    return ("cracked", "crack") if _fault_word(case) == "crack" else ("faulty", "fault")
+
+
 
 #: Why a statistic can differ from the paper's, by statistic (shown with the misses).
 MISS_REASONS = {
@@ -271,27 +342,40 @@ def _tables_dataset(result: StudyResult, case: Case):
         return np.array([[[float(table.get(g, {}).get(m, {}).get(k, np.nan)) for k in stats]
                           for m in models] for g in sigs])
 
+    # mixed units: each element's unit is in a coordinate that a selection keeps, e.g.
+    # ds.table2.sel(signal="transmission_error", statistic2="std").statistic2_units -> "rad"
+    units2 = [[units[g] if k in ("mean", "std") else "1" for k in st2] for g in sigs]
+    units3 = ["deg" if k == "pm_mean_deg" else "1" for k in st3]
+    per2 = {"units_coordinate": "statistic2_units",
+            "comment": "units differ by signal and statistic (mean and STD in the signal's "
+                       "unit, the shape statistics dimensionless): no single units attribute; "
+                       "each element's unit is the coordinate statistic2_units, kept by .sel(), "
+                       "e.g. table2.sel(signal='transmission_error', statistic2='std')"
+                       ".statistic2_units"}
+    per3 = {"units_coordinate": "statistic3_units",
+            "comment": "units differ by statistic (kurtoses dimensionless, pm_mean_deg in "
+                       "deg): no single units attribute; each element's unit is the coordinate "
+                       "statistic3_units, kept by .sel()"}
     if t2:
         data["table2"] = (("signal", "model", "statistic2"), arr(t2, st2), {
-            "long_name": "statistics of the TSA of the cracked records (paper's Table 2): mean "
-                         "and STD in the signal's unit (see signal_units), skewness g1, Pearson "
-                         "kurtosis, crest factor max|x - mean|/STD; model I-static is "
-                         "geardyn's addition (K(theta) at the static operating centre distance)",
-            "units": "see signal_units"})
+            "long_name": "statistics of the TSA of the faulty ('cracked') records (paper's "
+                         "Table 2): mean, STD, skewness g1, Pearson kurtosis, crest factor "
+                         "max|x - mean|/STD; model I-static is geardyn's addition (K(theta) at "
+                         "the static operating centre distance)", **per2})
         data["table3"] = (("signal", "model", "statistic3"), arr(t3, st3), {
-            "long_name": "kurtoses of the narrowband envelope, AM, PM and residual of the "
-                         "cracked records (paper's Table 3); pm_mean_deg in deg",
-            "units": "1"})
+            "long_name": "kurtoses of the narrowband envelope, AM, PM and residual and the PM "
+                         "level (pm_mean_deg) of the faulty ('cracked') records (paper's "
+                         "Table 3)", **per3})
         if result.paper_case:
             data["paper_table2"] = (("signal", "model", "statistic2"), arr(PAPER_TABLE2, st2),
                                     {"long_name": "the paper's Table 2 (NaN for model I-static: "
-                                                  "not in the paper)",
-                                     "units": "see signal_units"})
+                                                  "not in the paper)", **per2})
             data["paper_table3"] = (("signal", "model", "statistic3"),
                                     arr(PAPER_TABLE3, st3[:4] + ["-"]),
                                     {"long_name": "the paper's Table 3 and residual kurtoses "
-                                                  "(NaN for model I-static: not in the paper)",
-                                     "units": "1"})
+                                                  "(NaN for model I-static: not in the paper, "
+                                                  "and for pm_mean_deg: the paper gives no "
+                                                  "level)", **per3})
     cm = s.get("condition_metrics", {})
     if cm:
         vals = np.array([[[[np.nan if m not in cm[g] or cm[g][m][state][k] is None
@@ -333,20 +417,40 @@ def _tables_dataset(result: StudyResult, case: Case):
             [mc[st]["static_centre_distance_change_mm"] * 1e-3 for st in mc_states]), {
                 "units": "m", "long_name": "centre distance change at which model I-static "
                                            "reads K(theta) (static operating point, eq. 4)"})
-    coords = {"signal": sigs, "model": models, "statistic2": st2, "statistic3": st3,
-              "state": ["healthy", "cracked"], "metric": list(CONDITION_METRICS)}
+    coords = {
+        "signal": ("signal", sigs, {"long_name": "signal of Tables 2 and 3 (the paper's name; "
+                                                 "units in the root attribute signal_units)"}),
+        "model": ("model", models, {"long_name": "dynamic model (I-static is geardyn's)"}),
+        "statistic2": ("statistic2", st2, {"long_name": "statistic of Table 2"}),
+        "statistic3": ("statistic3", st3, {"long_name": "statistic of Table 3"}),
+        "state": ("state", ["healthy", "cracked"],
+                  {"long_name": "state of the pair ('cracked': the case's faulty pair, whatever "
+                                "its fault)"}),
+        "metric": ("metric", list(CONDITION_METRICS),
+                   {"long_name": "condition metric (MATLAB gearConditionMetrics name)"})}
+    if t2:
+        coords["statistic2_units"] = (("signal", "statistic2"), units2,
+                                      {"long_name": "units of each Table 2 statistic"})
+        coords["statistic3_units"] = ("statistic3", units3,
+                                      {"long_name": "units of each Table 3 statistic"})
     if mc_states:
-        coords["comparison_state"] = mc_states
-        coords["compared_signal"] = mc_signals
+        coords["comparison_state"] = ("comparison_state", mc_states, {
+            "long_name": "state of the compared records ('cracked': the faulty pair)"})
+        coords["compared_signal"] = ("compared_signal", mc_signals, {
+            "long_name": "simulated signal compared between the models (runs/*.nc variable)"})
         coords["compared_signal_units"] = ("compared_signal",
                                            [mc[mc_states[0]]["signals"][g]["units"]
-                                            for g in mc_signals])
+                                            for g in mc_signals],
+                                           {"long_name": "units of each compared signal"})
     if "indicators" in meas:
-        coords["variant"] = list(VARIANTS)
-        coords["indicator"] = [k for k, _, _ in INDICATORS]
+        coords["variant"] = ("variant", list(VARIANTS), {
+            "long_name": "measurement variant (tooth errors, sensor noise)"})
+        coords["indicator"] = ("indicator", [k for k, _, _ in INDICATORS], {
+            "long_name": "indicator of the TSA (Table 2/3 statistic or condition metric)"})
+    used = {dim for d in data.values() for dim in
+            ((d[0],) if isinstance(d[0], str) else d[0])}
     ds = xr.Dataset(data, coords={k: v for k, v in coords.items()
-                                  if any(k in d[0] for d in data.values())
-                                  or (k == "compared_signal_units" and mc_states)})
+                                  if set((v[0],) if isinstance(v[0], str) else v[0]) <= used})
     ds.attrs.update({
         "title": (f"geardyn: {'the Xue & Howard (2018) case study' if result.paper_case else ''}"
                   f"{'' if result.paper_case else repr(case.name) + ' (not the paper case)'}"),
@@ -424,6 +528,20 @@ def _zero_small(x: float, tiny: float) -> float:
     return 0.0 if abs(x) <= tiny else x
 
 
+def _fmt_num(v) -> str:
+    return "undefined" if v is None or not math.isfinite(v) else f"{v:.4g}"
+
+
+def _fault_description(case: Case) -> str:
+    """The case's faults in a few words, e.g. "spall on pinion tooth 11"."""
+    parts = [f"{f.get('type')} on {f.get('gear') or 'pinion'} tooth {f.get('tooth')}"
+             for f in (_get(case, "faults") or []) if isinstance(f, dict)]
+    if case.crack is not None and case.crack.active:
+        parts.insert(0, f"{case.crack.depth * 1e3:g} mm root crack on {case.crack.gear} tooth "
+                        f"{case.crack.tooth}")
+    return ", ".join(parts) or "no fault: the same pair as the healthy one"
+
+
 def _fault_word(case: Case) -> str:
     """What the narrowband envelope's peak locates: "crack", "fault", "faults" or "" (a healthy
     pair: the peak then locates nothing)."""
@@ -494,6 +612,7 @@ def report_stage(case: Case, out: Path, result: StudyResult) -> None:
                  f"{'finite elements' if method == 'fe' else 'the potential energy method'}"
                  f"{' | QUICK run (shorter records)' if result.quick else ''}")
     rep = Report(title, out, subtitle=subtitle)
+    faulty, fault = _faulty_words(case)
     F = result.figures
     done = {"n": 1}
 
@@ -565,7 +684,7 @@ def report_stage(case: Case, out: Path, result: StudyResult) -> None:
     rep.paragraph("Every value of the case with its source. Values marked 'geardyn default' "
                   "(in amber) are not given by the paper; the source says what geardyn chose "
                   "and why.")
-    rows = _case_rows(case)
+    rows = _case_table_rows(case, [d["key"] for d in s.get("differences_from_paper", [])])
     rep.table(["key", "value (SI)", "source"], rows, left_columns=3,
               classes=[["", "", "assume" if r[2].startswith("geardyn") else ""] for r in rows])
 
@@ -598,12 +717,15 @@ def report_stage(case: Case, out: Path, result: StudyResult) -> None:
            if method == "fe" else
            "potential energy (Hertz, bending, shear, axial compression over the exact involute "
            "+ trochoid tooth, fillet-foundation of Sainsot et al.)")
+    grid = result.maps.get("healthy")
+    dd = (np.asarray(grid.dd, dtype=float) if grid is not None else
+          np.linspace(case.stiffness.centre_distance_min, case.stiffness.centre_distance_max,
+                      case.stiffness.centre_distances))
     rep.paragraph(
         f"Method: {how}, face width {case.pair.face_width * 1e3:g} mm, "
         f"E = {case.material.youngs_modulus / 1e9:g} GPa. The map covers centre distance "
-        f"changes {case.stiffness.centre_distance_min * 1e3:g} to "
-        f"{case.stiffness.centre_distance_max * 1e3:g} mm on {case.stiffness.centre_distances} "
-        "grid lines with boundary-fitted nodes.")
+        f"changes {dd[0] * 1e3:g} to {dd[-1] * 1e3:g} mm on {dd.size} grid lines with "
+        "boundary-fitted nodes.")
     mm = s.get("mean_mesh_stiffness_N_per_m", {})
     if mm:
         rep.table(["centre distance change", "mean k_mb [N/m]"], list(mm.items()),
@@ -622,7 +744,8 @@ def report_stage(case: Case, out: Path, result: StudyResult) -> None:
     sims = s.get("simulations", {})
     srows = []
     for key, v in sims.items():
-        srows.append([key.replace("_", " "), v.get("mean_centre_distance_change_m", 0) * 1e3,
+        srows.append([key.replace("_", " ").replace("cracked", faulty),
+                      v.get("mean_centre_distance_change_m", 0) * 1e3,
                       v.get("mean_pressure_angle_deg"), v.get("mean_contact_ratio"),
                       v.get("mean_contact_ratio_eq8"), v.get("mean_pinion_speed_rad_s"),
                       v.get("mean_transmission_error_rad"), v.get("steps_iterating_fraction"),
@@ -632,7 +755,7 @@ def report_stage(case: Case, out: Path, result: StudyResult) -> None:
                "steps iterating [-]", "max |b1 - b2| before [um]"], srows,
               caption="Simulated records (means over the recorded time)")
     fig("fig8_design_parameters", "Fig. 8 analogue: centre distance change, operating pressure "
-                                  "angle and contact ratio of model II around a crack event; "
+                                  f"angle and contact ratio of model II around a {fault} event; "
                                   "time from the start of the record.")
     fig("fig9_iteration", "Fig. 9 analogue: |b1 - b2| before and after the iteration, the "
                           "number of iterations and the mesh stiffness used.")
@@ -641,7 +764,7 @@ def report_stage(case: Case, out: Path, result: StudyResult) -> None:
                            "at the static operating centre distance (not in the paper).")
     mc = s.get("model_comparison", {})
     if mc:
-        _model_comparison_section(rep, mc, method, fig)
+        _model_comparison_section(rep, mc, method, fig, faulty)
 
     # ---------------------------------------------------------------- diagnostics
     rep.heading("Diagnostics (Figs. 11-23, Tables 2 and 3)")
@@ -704,9 +827,10 @@ def report_stage(case: Case, out: Path, result: StudyResult) -> None:
 
     cm = s.get("condition_metrics", {})
     if cm:
-        _condition_metrics_section(rep, cm, s.get("condition_metrics_undefined", {}))
+        _condition_metrics_section(rep, cm, s.get("condition_metrics_undefined", {}),
+                                   (faulty, fault))
     if "measurement" in s:
-        _measurement_section(rep, s["measurement"], result, fig)
+        _measurement_section(rep, s["measurement"], result, fig, case, (faulty, fault))
 
     # ---------------------------------------------------------------- checks, comparisons
     rep.heading("Consistency checks (not validation)")
@@ -734,6 +858,13 @@ def report_stage(case: Case, out: Path, result: StudyResult) -> None:
     # ---------------------------------------------------------------- run details
     rep.heading("Run details")
     rep.paragraph(RESULTS_LAYOUT)
+    if faulty != "cracked":
+        rep.paragraph(
+            "Key names: in summary.json, results.nc (state 'cracked', stiffness/cracked, "
+            "diagnostics/model_<M>_cracked) and the runs/*_cracked.nc files, 'cracked' names "
+            f"the {faulty} pair of this case ({_fault_description(case)}) and crack_angle_deg "
+            f"the angle where its {fault} shows; the names are kept for every fault so scripts "
+            "read every run alike.")
     files = [("results.nc", _size(out / "results.nc"))]
     run_files = s.get("run_files", {})
     for rel in run_files.values():
@@ -778,11 +909,14 @@ def _rows_table(rep: Report, rows: list[dict], ref_label: str) -> None:
               classes=[["", "", "", "", "pass" if r["pass"] else "fail", "", ""] for r in rows])
 
 
-def _condition_metrics_section(rep: Report, cm: dict, undefined: dict) -> None:
-    rep.heading("Crack detection: condition metrics, healthy against cracked", level=3)
+def _condition_metrics_section(rep: Report, cm: dict, undefined: dict,
+                               words: tuple[str, str] = ("cracked", "crack")) -> None:
+    faulty, fault = words
+    rep.heading(f"{fault.capitalize()} detection: condition metrics, healthy against {faulty}",
+                level=3)
     rep.paragraph("Condition metrics of the TSA (MATLAB gearConditionMetrics names; NA4* "
-                  "uses the healthy record's residual variance as baseline). The crack counts "
-                  "as detected by a metric when the cracked value exceeds the healthy one by "
+                  f"uses the healthy record's residual variance as baseline). The {fault} counts "
+                  f"as detected by a metric when the {faulty} value exceeds the healthy one by "
                   "more than 50%.")
     ratio_undef = "EnergyRatio cracked / healthy" in undefined
     if undefined:
@@ -809,13 +943,16 @@ def _condition_metrics_section(rep: Report, cm: dict, undefined: dict) -> None:
                 rows4.append([f"{name.replace('_', ' ')}, model {m}" if k == "FM0" else "", k,
                               *cells])
                 cls4.append(["", "", "", "", "", "pass" if det else ""])
-    rep.table(["signal, model", "metric", "healthy", "cracked", "cracked / healthy", "crack"],
+    rep.table(["signal, model", "metric", "healthy", faulty, f"{faulty} / healthy", fault],
               rows4, left_columns=2, classes=cls4)
 
 
-def _measurement_section(rep: Report, m: dict, result: StudyResult, fig) -> None:
+def _measurement_section(rep: Report, m: dict, result: StudyResult, fig, case: Case,
+                         words: tuple[str, str] = ("cracked", "crack")) -> None:
     """The paper's indicators on a realistic measurement (:mod:`.paper_measurement`)."""
-    from .paper_measurement import INDICATORS, VARIANTS, statements
+    from .paper_measurement import INDICATORS, NOT_COMPUTED, VARIANTS, statements
+
+    faulty, fault = words
 
     rep.heading("The indicators on a realistic measurement (housing accelerometer, tooth "
                 "errors, noise)", level=3)
@@ -840,7 +977,7 @@ def _measurement_section(rep: Report, m: dict, result: StudyResult, fig) -> None
         + (f"; this stage took {secs:.1f} s." if secs is not None else "."))
     if m.get("undefined", {}).get("ideal"):
         rep.note("On the ideal record the healthy residual is numerical remainder (all teeth "
-                 "alike), so NA4* and the cracked / healthy energy ratio are undefined there, "
+                 f"alike), so NA4* and the {faulty} / healthy energy ratio are undefined there, "
                  "as in the table above; with tooth errors or noise the healthy baseline is "
                  "real and they are finite.")
     labels = {k: (lab, src) for k, lab, src in INDICATORS}
@@ -859,7 +996,8 @@ def _measurement_section(rep: Report, m: dict, result: StudyResult, fig) -> None
         rep.table(["indicator", "source", "state velocity, exact angle", "sensor: ideal",
                    "errors only", "noise only", "errors + noise", "driven by"], rows,
                   left_columns=2, left=(7,),
-                  caption=f"{state.capitalize()} pair: indicators of the TSA of the gear "
+                  caption=f"{state.replace('cracked', faulty).capitalize()} pair: indicators "
+                          "of the TSA of the gear "
                           "vertical velocity (the paper's signal, from the tables above) and "
                           "of the housing acceleration in the four variants; 'driven by' is "
                           "the input whose variant lies closer to the realistic one (log "
@@ -877,20 +1015,25 @@ def _measurement_section(rep: Report, m: dict, result: StudyResult, fig) -> None
         dcls.append(cl)
     rep.table(["indicator", "ideal", "errors only", "noise only", "errors + noise"], drows,
               left_columns=1, classes=dcls,
-              caption="Cracked / healthy of each indicator on the housing acceleration "
-                      "(highlighted: above 1.5, the crack is seen)")
+              caption=f"{faulty.capitalize()} / healthy of each indicator on the housing "
+                      f"acceleration (highlighted: above 1.5, the {fault} is seen)")
     hd = m.get("housing_damping")
     if hd and "skipped" not in hd:
         hrows = []
+        skipped = {f"{float(k):g}" for k in hd.get("not_computed", {})}
         for i, zeta in enumerate(hd["damping_ratios"]):
             fh, fc = hd["healthy"]["FM4"][i], hd["cracked"]["FM4"][i]
+            if f"{zeta:g}" in skipped:  # the same word as the sentence below the table
+                hrows.append([100 * zeta, hd["decay_over_mesh_period"][i], *[NOT_COMPUTED] * 5])
+                continue
             hrows.append([100 * zeta, hd["decay_over_mesh_period"][i], fh, fc,
                           fc / fh if fh else float("nan"), hd["cracked"]["NA4star"][i],
                           hd["cracked"]["EnergyRatio"][i] / hd["healthy"]["EnergyRatio"][i]
                           if hd["healthy"]["EnergyRatio"][i] else float("nan")])
         rep.table(["damping ratio of every housing mode [%]",
-                   "decay time of the lowest mode / mesh period", "FM4 healthy", "FM4 cracked",
-                   "FM4 cracked / healthy", "NA4* cracked", "energy ratio cracked / healthy"],
+                   "decay time of the lowest mode / mesh period", "FM4 healthy",
+                   f"FM4 {faulty}", f"FM4 {faulty} / healthy", f"NA4* {faulty}",
+                   f"energy ratio {faulty} / healthy"],
                   hrows, left_columns=0,
                   caption="The realistic record (errors + noise) through the same transfer path "
                           "with every mode's damping ratio set to each value: how much of the "
@@ -899,15 +1042,27 @@ def _measurement_section(rep: Report, m: dict, result: StudyResult, fig) -> None
                           + "; this case's damping ratios: "
                           + ", ".join(f"{100 * z:g}%" for z in hd["case_damping_ratios"]) + ")")
     rep.paragraph("What the numbers say (computed from the tables, not written by hand):")
-    rep.bullets(statements(m))
+    rep.bullets(statements(m, words))
     fig("fig24_measured_tsa", "TSA of the housing acceleration over one revolution from the "
                               "tachometer: ideal, tooth errors only, and tooth errors with "
-                              "noise (the realistic record), healthy and cracked.")
-    rep.paragraph("The same realistic record as a file: geardyn measure --set "
-                  "modifications.pinion.grade=6 --set modifications.pinion.seed=1 --set "
-                  "modifications.gear.grade=6 --set modifications.gear.seed=2 --no-crack "
-                  "--out healthy.nc, then geardyn diagnose healthy.nc --signal acc --tach tach "
-                  "--teeth 23 (for this case's own errors, leave out the --set options).")
+                              f"noise (the realistic record), healthy and {faulty}.")
+    cmd = m.get("reproduce")
+    if cmd:
+        real = m["indicators"]["errors+noise"]
+        rep.paragraph(
+            "The same realistic records as files (this run's effective case as it wrote it to "
+            "case.toml: case file, --set overrides, stiffness method"
+            + ("; the case's own [modifications] are the tooth errors" if cmd["own_errors"]
+               else "; the --set modifications options are the tooth errors above")
+            + "; the record as long as this section's, "
+            + f"{m['records']['errors+noise|healthy']['record_s']:.4g} s"
+            + (", and the --quick run's coarser map and shorter settling" if result.quick
+               else "")
+            + f"; paths from the folder the run was started in): {cmd['healthy']} and "
+            f"{cmd['faulty']}, then {cmd['diagnose_healthy']} and {cmd['diagnose_faulty']}. "
+            "The metrics.json that diagnose writes then holds this section's FM4 of the "
+            f"realistic record, {_fmt_num(real['healthy']['FM4'])} healthy and "
+            f"{_fmt_num(real['cracked']['FM4'])} {faulty}.")
 
 
 #: Appended to the captions of Tables 2 and 3.
@@ -943,7 +1098,7 @@ def _finite(signals: dict, key: str) -> dict:
             if v.get(key) is not None and math.isfinite(v[key])}
 
 
-def model_comparison_statements(mc: dict, method: str) -> list[str]:
+def model_comparison_statements(mc: dict, method: str, faulty: str = "cracked") -> list[str]:
     """What the model comparison says, in words, generated from its numbers.
 
     Parameters
@@ -952,6 +1107,8 @@ def model_comparison_statements(mc: dict, method: str) -> list[str]:
         ``summary["model_comparison"]`` (:func:`geardyn.studies.paper.model_comparison`).
     method : {"fe", "pem"}
         Stiffness method of the run (the PEM's handover steps get their own sentence).
+    faulty : str
+        The report's word for the state ``"cracked"`` ("faulty" when the fault is not a crack).
 
     Returns
     -------
@@ -973,7 +1130,8 @@ def model_comparison_statements(mc: dict, method: str) -> list[str]:
         if not d_s or not d_1:
             continue
         worst = max(d_s, key=d_s.get)
-        text = (f"{st.capitalize()} pair: model I-static reproduces model II to within "
+        text = (f"{st.replace('cracked', faulty).capitalize()} pair: model I-static "
+                "reproduces model II to within "
                 f"{_pct(d_s[worst])} of each signal's STD (largest over the {len(d_s)} signals: "
                 f"{worst.replace('_', ' ')}), against {_pct(min(d_1.values()))} to "
                 f"{_pct(max(d_1.values()))} for model I")
@@ -1004,7 +1162,8 @@ def model_comparison_statements(mc: dict, method: str) -> list[str]:
     return out
 
 
-def _model_comparison_section(rep: Report, mc: dict, method: str, fig) -> None:
+def _model_comparison_section(rep: Report, mc: dict, method: str, fig,
+                              faulty: str = "cracked") -> None:
     """The model comparison: table, figure and the generated statements."""
     rep.heading("How much of the model II - model I difference the static shift explains",
                 level=3)
@@ -1023,7 +1182,8 @@ def _model_comparison_section(rep: Report, mc: dict, method: str, fig) -> None:
         if st not in mc:
             continue
         for i, (name, v) in enumerate(mc[st]["signals"].items()):
-            rows.append([st if i == 0 else "", name.replace("_", " "), v.get("units", ""),
+            rows.append([st.replace("cracked", faulty) if i == 0 else "",
+                         name.replace("_", " "), v.get("units", ""),
                          _pct(v.get("rms_ii_minus_i_static")), _pct(v.get("rms_ii_minus_i")),
                          _pct(v.get("explained_fraction")), _pct(v.get("top_share"))])
     rep.table(["pair", "signal", "unit", "RMS(II - I-static) / STD(II)", "RMS(II - I) / STD(II)",
@@ -1033,4 +1193,4 @@ def _model_comparison_section(rep: Report, mc: dict, method: str, fig) -> None:
     fig("fig_model_comparison", "RMS(II - I) / STD(II) and RMS(II - I-static) / STD(II) per "
                                 "signal (log scale).")
     rep.paragraph("What the numbers say (generated from the table):")
-    rep.bullets(model_comparison_statements(mc, method))
+    rep.bullets(model_comparison_statements(mc, method, faulty))

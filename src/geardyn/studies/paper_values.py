@@ -19,7 +19,7 @@ SIGNAL_KEYS = {"v_yg": "gear_vertical_velocity", "omega_p": "pinion_angular_velo
 #: Human titles (with units) of the three signals, by summary.json key.
 SIGNAL_TITLES = {"gear_vertical_velocity": "output gear vertical velocity [m/s]",
                  "pinion_angular_velocity": "input pinion angular velocity [rad/s]",
-                 "transmission_error": "transmission error theta_p - theta_g [rad]"}
+                 "transmission_error": "transmission error theta_p - (r_b2/r_b1) theta_g [rad]"}
 
 #: Condition metrics compared healthy against cracked (MATLAB gearConditionMetrics names).
 CONDITION_METRICS = ("FM0", "FM4", "M6A", "M8A", "NA4", "NA4star", "EnergyRatio", "Kurtosis")

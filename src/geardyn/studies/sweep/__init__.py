@@ -26,7 +26,7 @@ strings) names a base case and what changes from run to run::
     mesh.damping_ratio = { low = 0.03, high = 0.12, scale = "log" }
 
     [store]                    # what is kept per run besides the metrics
-    signals = ["v_yg", "omega_p", "transmission_error"]
+    signals = ["v_yg", "omega_p", "transmission_error"]   # RECORD_SIGNALS (with units)
     tsa = false                # the synchronous averages
     raw = false                # the recorded series
     noise_snr_db = 30          # optional measurement noise, seeded per run
@@ -90,6 +90,7 @@ Entry points: :func:`load_sweep`, :meth:`Sweep.plan`, :func:`run_sweep`, :func:`
 from .evaluate import Evaluator, GeardynEvaluator, Output, diagnostic_features, evaluate_run
 from .execute import SweepResult, run_sweep, sweep_digest
 from .integrity import DamagedBatch, StoreCheck, verify_store
+from .signals import RECORD_SIGNALS
 from .spec import (
     DEFAULT_MAX_RUNS,
     DEFAULT_SIGNALS,
@@ -116,6 +117,7 @@ __all__ = [
     "STATUS_FAILED",
     "ERROR_CHARS",
     "DEFAULT_SIGNALS",
+    "RECORD_SIGNALS",
     "SweepFile",
     "Sweep",
     "SweepPlan",

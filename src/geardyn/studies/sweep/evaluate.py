@@ -17,6 +17,7 @@ import numpy as np
 
 from ...config import Case
 from ...errors import InputError
+from .signals import RECORD_SIGNALS, check_signal_names, short_record_error
 from .spec import StoreSpec
 
 __all__ = ["Output", "Evaluator", "GeardynEvaluator", "evaluate_run", "diagnostic_features"]
@@ -284,6 +285,7 @@ def evaluate_run(case: Case, store_options: StoreSpec | None = None, seed: int =
         From the geometry, the map, the simulation (NumericalError on divergence) or the
         diagnostics.
     """
+    from ...diagnostics.tsa import ShortRecordError
     from ...dynamics import simulate, summary
 
     opts = store_options or StoreSpec()
@@ -302,9 +304,12 @@ def evaluate_run(case: Case, store_options: StoreSpec | None = None, seed: int =
                    for k, v in signals.items()}
     d = case.diagnostics
     teeth = int(np.asarray(ds.attrs.get("pinion_teeth", case.pinion.teeth)).reshape(-1)[0])
-    out = diagnostic_features(signals, angle, teeth=teeth, samples_per_rev=d.samples_per_rev,
-                              harmonic=d.harmonic, bandwidth=d.bandwidth,
-                              residual_preset=d.residual_preset, keep_tsa=opts.tsa)
+    try:
+        out = diagnostic_features(signals, angle, teeth=teeth, samples_per_rev=d.samples_per_rev,
+                                  harmonic=d.harmonic, bandwidth=d.bandwidth,
+                                  residual_preset=d.residual_preset, keep_tsa=opts.tsa)
+    except ShortRecordError as exc:  # in the sweep's terms: simulation.record_time
+        raise short_record_error(exc, ds, case) from None
     summ = summary(ds)
     for key, name, _, scale, _ in _SUMMARY:
         out[name] = float(summ[key]) * scale
@@ -343,15 +348,14 @@ class GeardynEvaluator(Evaluator):
 
     def __init__(self, store: StoreSpec | None = None):
         self.store = store or StoreSpec()
+        check_signal_names(self.store.signals)
 
     @property
     def needs_pilot(self) -> bool:  # type: ignore[override]
         return self.store.raw
 
     def _units(self, signal: str) -> str:
-        from ...diagnostics import SIMULATION_SIGNALS
-
-        return SIMULATION_SIGNALS.get(signal, "")
+        return RECORD_SIGNALS[signal]  # __init__ accepts only these names
 
     def outputs(self, case: Case, pilot: Mapping[str, Any] | None = None) -> list[Output]:
         d = case.diagnostics

@@ -26,7 +26,7 @@ from ...config import Case
 from ...errors import DataFileError, InputError
 from .evaluate import Evaluator, GeardynEvaluator, Output
 from .integrity import verify_store
-from .spec import Sweep, SweepPlan, load_sweep
+from .spec import Sweep, SweepPlan, check_runnable, load_sweep
 from .store import (
     STATUS_FAILED,
     STATUS_OK,
@@ -258,23 +258,37 @@ def _dask_client(scheduler: str | None, workers: int | None, client) -> Iterator
                 cl.close()
         return
     n = workers or os.cpu_count() or 1
+    # distributed's nannies write their workers' variables (OMP_NUM_THREADS=1, PYTHONHASHSEED,
+    # MALLOC_TRIM_THRESHOLD_, ...) into this process's environment and leave them: put back
+    # what was there once the cluster is closed (a notebook's later subprocesses inherit it)
+    environ = dict(os.environ)
     # the worker processes ignore Ctrl-C (SIGINT reaches the whole terminal process group):
     # this process cancels the tasks and closes the cluster, with no traceback from each worker
     main = threading.current_thread() is threading.main_thread()
     old = signal.signal(signal.SIGINT, signal.SIG_IGN) if main else None
     try:
+        # no dashboard, and the scheduler's HTTP server (health, metrics) on a free port of
+        # this host: with dashboard_address=None it asks for 8787 and Dask warns "Port 8787 is
+        # already in use" whenever another Dask runs here
         cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                               dashboard_address=None, silence_logs=logging.ERROR)
+                               dashboard_address="127.0.0.1:0",
+                               scheduler_kwargs={"dashboard": False},
+                               silence_logs=logging.ERROR)
     finally:
         if main:
             signal.signal(signal.SIGINT, old)
     cl = Client(cluster)
-    with _loop_logs_held():  # the shutdown included
-        try:
-            yield cl
-        finally:
-            cl.close()
-            cluster.close()
+    try:
+        with _loop_logs_held():  # the shutdown included
+            try:
+                yield cl
+            finally:
+                cl.close()
+                cluster.close()
+    finally:
+        for key in set(os.environ) - set(environ):
+            del os.environ[key]
+        os.environ.update(environ)
 
 
 def run_sweep(
@@ -338,6 +352,8 @@ def run_sweep(
     if workers is not None and (scheduler or client is not None):
         raise InputError("--workers", workers, "only with the local cluster (not with "
                                                "--scheduler)")
+    if evaluate is None or isinstance(evaluate, GeardynEvaluator):
+        check_runnable(sweep)  # again: --config/--set may have changed the base case
     evaluator = evaluate or GeardynEvaluator(sweep.spec.store)
     plan = sweep.plan()
     out = Path(out).absolute()

@@ -85,7 +85,8 @@ class StoreSpec(_SweepModel):
     """What is stored per run besides status, error and timing."""
 
     signals: list[str] = Field(default_factory=lambda: list(DEFAULT_SIGNALS),
-                               description="Simulation variables diagnosed (angle: theta_p).")
+                               description="Simulation variables diagnosed (angle: theta_p): "
+                                           "names of signals.RECORD_SIGNALS.")
     tsa: bool = Field(False, strict=True, description="Store each signal's synchronous average.")
     raw: bool = Field(False, strict=True,
                       description="Store the recorded series (signals and theta_p).")
@@ -103,7 +104,7 @@ class StoreSpec(_SweepModel):
         bad = [s for s in v if not s.isidentifier()]
         if bad:
             raise ValueError(f"variable names of the simulation result (got {bad})")
-        return v
+        return v  # names the record lacks: signals.check_signal_names (named, when loaded)
 
     @field_validator("noise_snr_db")
     @classmethod

@@ -35,6 +35,7 @@ from .schema import (
     SweepFile,
     _format_sweep_error,
 )
+from .signals import check_demodulation_band, check_record_length, check_sweep_signals
 
 __all__ = ["SweepFile", "RangeSpec", "DimensionSpec", "SampleSpec", "StoreSpec", "ExecutionSpec",
            "Sweep", "SweepPlan", "Parameter", "load_sweep", "parse_sweep", "run_seeds",
@@ -230,7 +231,17 @@ def _resolve(spec: SweepFile, text: str, origin: str, base_dir: Path,
     _check_store_compatible(spec.store, set(seen) - set(spec.set))
     sweep = Sweep(spec, base, text, origin, tuple(axes), tuple(dims), links)
     _check_values(sweep)
+    check_runnable(sweep)
     return sweep
+
+
+def check_runnable(sweep: Sweep) -> None:
+    """The checks of what every run would find the same, before any run: signals the sweep's
+    model records, a record long enough to average, a demodulation band the runs can use (see
+    :mod:`.signals`)."""
+    check_sweep_signals(sweep, sweep.spec.store.signals)
+    check_record_length(sweep)
+    check_demodulation_band(sweep)
 
 
 def _check_store_compatible(store: StoreSpec, swept: set[str]) -> None:

@@ -1,0 +1,215 @@
+"""Bad arguments to the public Python API are refused by name (QA walkthrough).
+
+Each call below used to fail deep inside numpy, pathlib or the standard library (AttributeError,
+TypeError, ValueError, KeyError), or returned NaN or an empty result. Now each raises
+:class:`geardyn.errors.InputError` whose ``field`` is the argument's name and whose message
+names the argument, the value and what is allowed. Two inputs are accepted instead: a single
+override string (``paper_case("pinion.teeth=25")``) and a torque with a unit in the static
+transmission error (``"100 N m"``, as in a case file).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import geardyn
+from geardyn.errors import InputError
+from geardyn.geometry import centre_distance_from_displacements
+from geardyn.static_te import static_te_curves, static_te_of_case
+from geardyn.stiffness import StiffnessMap, build_map
+
+NAN = float("nan")
+
+
+@pytest.fixture(scope="module")
+def case():
+    return geardyn.paper_case()
+
+
+@pytest.fixture(scope="module")
+def pair(case):
+    return case.gear_pair()
+
+
+@pytest.fixture(scope="module")
+def kmap(pair):
+    """A small table map over one mesh cycle (no load shares: equal shares)."""
+    th = np.linspace(0.0, pair.mesh_angle, 40, endpoint=False)
+    return StiffnessMap.from_table(pair, th, 3e8 + 1e8 * np.cos(th * pair.pinion.teeth),
+                                   n_seg=4)
+
+
+def _refused(call, field: str, exc_type=InputError) -> InputError:
+    """``call()`` raises ``exc_type`` for ``field``, named first in its one-line message."""
+    with pytest.raises(exc_type) as info:
+        call()
+    err = info.value
+    assert err.field == field
+    assert str(err).startswith(f"{field}: got ")
+    assert "allowed: " in str(err)
+    return err
+
+
+# ------------------------------------------------------------------------- geometry
+def test_gear_pair_refuses_what_is_not_a_gear(pair):
+    _refused(lambda: geardyn.GearPair("x", pair.gear), "pinion")
+    _refused(lambda: geardyn.GearPair(pair.pinion, None), "gear")
+
+
+def test_gear_refuses_a_unit_string():
+    err = _refused(lambda: geardyn.Gear(teeth=20, module="3 mm", pressure_angle=0.349),
+                   "module")
+    assert "m" in err.allowed
+
+
+@pytest.mark.parametrize("value", ["1 mm", None, [0.001]])
+def test_operating_refuses_non_numbers(pair, value):
+    _refused(lambda: pair.operating(value), "centre_distance_change")
+
+
+def test_operating_takes_numpy_numbers(pair):
+    assert pair.operating(np.float32(0.0)).contact_ratio == pair.operating(0.0).contact_ratio
+    assert pair.operating(np.array(0.0)).centre_distance == pair.design_centre_distance
+
+
+@pytest.mark.parametrize("theta", [NAN, math.inf, "0.1", 1e30])
+def test_contact_points_refuses_bad_angles(pair, theta):
+    _refused(lambda: pair.contact_points(theta), "theta")
+
+
+def test_contact_points_refuses_bad_margin(pair):
+    _refused(lambda: pair.contact_points(0.0, margin=NAN), "margin")
+    _refused(lambda: pair.contact_points(0.0, margin=-1.0), "margin")
+
+
+@pytest.mark.parametrize("kw,field", [({"n_involute": -5}, "n_involute"),
+                                      ({"n_involute": 0}, "n_involute"),
+                                      ({"n_involute": 2.5}, "n_involute"),
+                                      ({"n_fillet": 0}, "n_fillet"),
+                                      ({"n_fillet": True}, "n_fillet")])
+def test_outline_refuses_bad_point_counts(pair, kw, field):
+    _refused(lambda: pair.gear.outline(**kw), field)
+
+
+def test_outline_smallest_counts(pair):
+    o = pair.gear.outline(n_involute=2, n_fillet=2)
+    assert o.involute.shape == (2, 2) and o.fillet.shape == (2, 2)
+
+
+@pytest.mark.parametrize("radius", [NAN, math.inf, "0.07"])
+def test_thickness_at_refuses_non_finite_radius(pair, radius):
+    _refused(lambda: pair.gear.thickness_at(radius), "radius")
+
+
+@pytest.mark.parametrize("y_p,y_g,field", [("a", 0.0, "y_p"), (NAN, 0.0, "y_p"),
+                                           (0.0, math.inf, "y_g"),
+                                           (np.array([0.0, NAN]), 0.0, "y_p"),
+                                           (0.0, np.array(["a"]), "y_g")])
+def test_centre_distance_from_displacements_refuses_bad_values(pair, y_p, y_g, field):
+    _refused(lambda: centre_distance_from_displacements(pair, y_p, y_g), field)
+
+
+def test_centre_distance_from_displacements_pair_and_arrays(pair):
+    _refused(lambda: centre_distance_from_displacements("pair", 0.0, 0.0), "pair")
+    d = centre_distance_from_displacements(pair, [0.0, 0.0], 0.0)
+    np.testing.assert_allclose(d, pair.design_centre_distance, rtol=1e-15)
+
+
+def test_operating_geometry_documents_base_pitch():
+    assert "base_pitch :" in geardyn.OperatingGeometry.__doc__
+
+
+# ------------------------------------------------------------------------- config
+def test_load_case_refuses_a_number_as_path():
+    _refused(lambda: geardyn.load_case(123), "path")
+
+
+@pytest.mark.parametrize("value", [5, b"pinion.teeth=25", [5], {5: 1}])
+def test_overrides_of_the_wrong_type(case, value):
+    _refused(lambda: case.with_overrides(value), "overrides")
+    _refused(lambda: geardyn.paper_case(value), "overrides")
+
+
+def test_parse_overrides_refuses_non_strings():
+    _refused(lambda: geardyn.config.parse_overrides(7), "overrides")
+    _refused(lambda: geardyn.config.parse_overrides({"pinion.teeth": 25}), "overrides")
+
+
+def test_a_single_override_string_is_one_override(case):
+    """Accepted (not iterated character by character): the same as a one-element list."""
+    one = geardyn.paper_case("pinion.teeth=25")
+    assert one.pinion.teeth == 25
+    assert one == geardyn.paper_case(["pinion.teeth=25"])
+    assert case.with_overrides("pinion.teeth=25").pinion.teeth == 25
+    assert geardyn.config.parse_overrides("pinion.teeth=25") == {"pinion.teeth": 25}
+
+
+# ------------------------------------------------------------------------- stiffness map
+def test_map_refuses_unknown_variable_and_slot(kmap):
+    err = _refused(lambda: kmap(0.0, variable="foo"), "variable")
+    assert "'k_mb'" in err.allowed
+    _refused(lambda: kmap(0.0, slot=0), "slot")
+
+
+@pytest.mark.parametrize("theta", ["a", None, [NAN], math.inf])
+def test_map_refuses_bad_angles(kmap, theta):
+    _refused(lambda: kmap(theta), "theta")
+
+
+def test_map_refuses_bad_centre_distances(kmap):
+    _refused(lambda: kmap(0.0, "zero"), "dd")
+    _refused(lambda: kmap(0.0, None), "dd")
+    _refused(lambda: kmap(np.zeros(3), np.zeros(2)), "dd")
+
+
+def test_map_evaluation_unchanged(kmap):
+    th = np.linspace(0.0, 1.0, 7)
+    assert np.all(np.isfinite(kmap(th)))
+    assert kmap(0.3) == float(kmap(np.array([0.3]))[0])
+
+
+@pytest.mark.parametrize("n_theta", [-1, 0, 2.0])
+def test_regular_refuses_bad_counts(kmap, n_theta):
+    _refused(lambda: kmap.regular(n_theta=n_theta), "n_theta")
+
+
+@pytest.mark.parametrize("n_seg", [-1, 0, 1])
+def test_from_table_refuses_bad_n_seg(pair, n_seg):
+    th = np.linspace(0.0, pair.mesh_angle, 8, endpoint=False)
+    _refused(lambda: StiffnessMap.from_table(pair, th, np.full(8, 1e8), n_seg=n_seg), "n_seg")
+
+
+def test_build_map_refuses_what_is_not_a_case():
+    _refused(lambda: build_map("notacase"), "case")
+
+
+# ------------------------------------------------------------------------- static TE
+def test_static_te_takes_a_torque_with_a_unit(case, kmap):
+    """As the case files do: '100 N m' is 100 N m, '0.1 kN m' too."""
+    kw = dict(stiffness_map=kmap, errors=False, n=16)
+    plain = static_te_of_case(case, 100.0, **kw)
+    for text in ("100 N m", "0.1 kN m"):
+        ds = static_te_of_case(case, text, **kw)
+        assert ds.attrs["torque"] == pytest.approx(100.0, rel=1e-12)
+        np.testing.assert_allclose(ds["transmission_error"], plain["transmission_error"],
+                                   rtol=1e-12)
+    both = static_te_curves(case, "100 N m", centre_distance_change="0 mm", **kw)
+    assert list(both["torque"].values) == [0.0, 100.0]
+
+
+@pytest.mark.parametrize("torque", ["100 m", "lots", [100.0], b"100"])
+def test_static_te_refuses_bad_torques(case, kmap, torque):
+    _refused(lambda: static_te_of_case(case, torque, stiffness_map=kmap, errors=False, n=16),
+             "torque")
+
+
+def test_static_te_refuses_what_is_not_a_case(kmap):
+    _refused(lambda: static_te_of_case("case", 1.0, stiffness_map=kmap), "case")
+
+
+@pytest.mark.parametrize("n", [0, -3, 2.5])
+def test_static_te_refuses_bad_point_counts(case, kmap, n):
+    _refused(lambda: static_te_of_case(case, 1.0, stiffness_map=kmap, errors=False, n=n), "n")
