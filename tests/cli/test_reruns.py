@@ -138,7 +138,7 @@ def test_simulate_twice_is_up_to_date_and_other_inputs_are_refused(tmp_path):
     assert (out.stat().st_ino, out.stat().st_mtime_ns) == before  # not rewritten
     r3 = run("simulate", "-o", str(out), "--model", "i", *SHORT_SIM, cache=cache)
     line = _one_error_line(r3)
-    assert "holds results of different inputs (model 'II' -> 'I')" in line
+    assert "holds results of different inputs (simulation.model 'II' -> 'I')" in line
     r4 = run("simulate", "-o", str(out), "--model", "i", "--force", *SHORT_SIM, cache=cache)
     assert r4.returncode == 0, r4.stderr
 

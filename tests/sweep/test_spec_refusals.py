@@ -38,6 +38,26 @@ def refused(body: str) -> InputError:
 AXIS = '[axes]\nmotor.torque = ["50 N m", "60 N m"]\n'
 
 
+def refused_to_run(body: str) -> InputError:
+    """A sweep file that loads (a study's own evaluator may take short records) but that the
+    standard evaluator refuses before any run (``run_sweep`` calls ``check_runnable``)."""
+    from geardyn.studies.sweep.spec import check_runnable
+
+    loaded = sweep(body)
+    with pytest.raises(InputError) as info:
+        check_runnable(loaded)
+    assert "\n" not in str(info.value)
+    return info.value
+
+
+def runnable(body: str):
+    from geardyn.studies.sweep.spec import check_runnable
+
+    loaded = sweep(body)
+    check_runnable(loaded)
+    return loaded
+
+
 def test_unknown_and_absent_signals_are_refused_naming_them():
     e = refused(AXIS + '[store]\nsignals = ["v_yg", "foo"]\n')
     assert e.field == "store.signals" and e.value == ["foo"]
@@ -65,23 +85,25 @@ def test_unknown_and_absent_signals_are_refused_naming_them():
      "link.simulation.record_time", "0.01 s", 0.182),
 ])
 def test_a_record_shorter_than_a_revolution_is_refused(body, field, value, spans):
-    e = refused(body)
+    e = refused_to_run(body)
     assert e.field == field and e.value == value
     assert f"at least {TWO_REVS}" in e.allowed and "load.speed = 114.14 rad/s" in e.allowed
     assert f"spans {spans:.3g} revolutions" in e.allowed
 
 
 def test_the_lowest_swept_speed_counts_and_longer_records_pass():
-    e = refused('[set]\nsimulation.record_time = "0.1 s"\n'
-                '[axes]\nload.speed = ["114.14 rad/s", "20 rad/s"]\n')
+    e = refused_to_run('[set]\nsimulation.record_time = "0.1 s"\n'
+                       '[axes]\nload.speed = ["114.14 rad/s", "20 rad/s"]\n')
     assert e.field == "set.simulation.record_time" and e.value == "0.1 s"
     assert "load.speed = 20 rad/s (the lowest in the sweep)" in e.allowed
     assert f"at least {2 * 2 * math.pi / 20:.3g} s" in e.allowed
     # 1.45 revolutions: refused only when sure to fail (it may hold a whole revolution)
-    assert sweep('[set]\nsimulation.record_time = "0.08 s"\n' + AXIS).n_runs == 2
+    assert runnable('[set]\nsimulation.record_time = "0.08 s"\n' + AXIS).n_runs == 2
     # a speed the case does not fix (a given load coefficient): left to the runs
-    assert sweep('[set]\nsimulation.record_time = "0.03 s"\nload.coefficient = 0.8761\n'
-                 + AXIS).n_runs == 2
+    assert runnable('[set]\nsimulation.record_time = "0.03 s"\nload.coefficient = 0.8761\n'
+                    + AXIS).n_runs == 2
+    # the file itself loads: a study's own evaluator (no TSA) may take a short record
+    assert sweep('[set]\nsimulation.record_time = "0.03 s"\n' + AXIS).n_runs == 2
 
 
 def test_a_short_run_says_it_in_the_sweeps_terms():

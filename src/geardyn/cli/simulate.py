@@ -128,7 +128,8 @@ def simulate(
         from ..faults import without_faults
 
         case = without_faults(case)
-    ident = identity("simulate", case, {"model": which, "crack": crack, "stiffness": method})
+    # --model and --stiffness are in the case now (simulation.model, stiffness.method)
+    ident = identity("simulate", case, {"crack": crack})
     mat_path = out.with_suffix(".mat")
     up_to_date = False
     if out.exists():
