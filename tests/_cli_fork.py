@@ -4,13 +4,14 @@ The suite runs the CLI a few hundred times; a fresh ``python -m geardyn`` spends
 each on importing NumPy, SciPy, xarray, numba, matplotlib, scikit-fem, dask and zarr before
 geardyn starts (measured 2026-11-26: ``geardyn config validate`` 0.68 -> 0.22 s,
 ``geardyn diagnose`` 0.75 -> 0.31 s, a short ``geardyn simulate`` 1.48 -> 0.91 s). Here a
-server process imports those third-party libraries once per test worker and *forks* one child
-per command line: the child is a separate process that imports geardyn itself, runs its entry
+server process imports those third-party libraries (and geardyn's library modules, not its CLI)
+once per test worker and *forks* one child per command line: the child is a separate process
+that imports geardyn's CLI itself (its consoles see the child's environment), runs its entry
 point as ``python -m geardyn`` would (``__main__`` is ``geardyn.__main__``, so spawned
 helpers start the same way), with the test's arguments, environment, working folder and
 standard streams, and exits with the CLI's own exit code after a normal interpreter shutdown.
 Exit codes, output, tracebacks, files written and signals are the real ones; only the
-third-party imports were done before the fork.
+imports were done before the fork.
 
 :func:`run_geardyn` falls back to ``subprocess.run`` when the environment changes a variable
 that a library reads when it is imported (``NUMBA_*``, ``DASK_*``, ``MPL*``, ``PYTHON*``,
@@ -34,12 +35,21 @@ from pathlib import Path
 #: Environment variables read at import time by a pre-imported library: a change falls back.
 IMPORT_TIME_PREFIXES = ("NUMBA_", "DASK_", "MPL", "MATPLOTLIB", "PYTHON", "OMP_", "OPENBLAS_",
                         "MKL_", "MALLOC_", "LD_", "HDF5_", "ZARR_", "GMSH")
-#: What the server imports before forking (third-party only: geardyn is imported by each
-#: child, so its consoles and settings see the child's environment).
+#: What the server imports before forking (third-party; geardyn's library modules follow in
+#: PRELOAD_GEARDYN, its CLI is imported by each child, so its consoles see the child's
+#: environment).
 PRELOAD = ("numpy", "scipy.sparse", "scipy.sparse.linalg", "scipy.signal", "scipy.interpolate",
            "scipy.optimize", "scipy.stats", "xarray", "numba", "matplotlib.pyplot", "pydantic",
            "typer", "rich.console", "rich.progress", "skfem", "zarr", "dask", "dask.array",
            "h5netcdf")
+#: geardyn's library modules, imported by the server too (they read no environment variable
+#: when imported, and create no console: ``geardyn.cli`` and its rich consoles, which read
+#: COLUMNS and the terminal when created, are imported by each child); measured 0.1-0.2 s of
+#: each command line (2026-11-26).
+PRELOAD_GEARDYN = ("geardyn", "geardyn.config", "geardyn.geometry", "geardyn.cache", "geardyn.io",
+                   "geardyn.stiffness", "geardyn.stiffness.map", "geardyn.dynamics",
+                   "geardyn.diagnostics", "geardyn.measurement", "geardyn.studies.paper",
+                   "geardyn.studies.paper_report")
 
 _SERVER: dict[str, object] = {}
 
@@ -224,11 +234,12 @@ def _serve(req_fd: int, rep_fd: int) -> None:
     import importlib
 
     sys.path[0] = os.getcwd()  # not this script's folder (tests/): as ``python -m``
-    for name in PRELOAD:
+    for name in PRELOAD + PRELOAD_GEARDYN:
         try:
             importlib.import_module(name)
         except ImportError:  # an optional library missing: the child imports what it needs
             pass
+    assert not [m for m in sys.modules if m.startswith("geardyn.cli")], "no console before fork"
     buf = b""
     while True:
         while b"\n" not in buf:
