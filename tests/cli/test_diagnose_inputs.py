@@ -225,3 +225,24 @@ def test_no_figures_says_only_what_was_written(tmp_path):
     done = next(ln for ln in r.stdout.splitlines() if ln.startswith("done"))
     assert "metrics.json" in done and "figure" not in done
     assert not (out / "figures").exists()
+
+
+def test_bad_pulse_times_are_named_by_the_tach_option(tmp_path):
+    """The TSA's own argument (``tach_times``) is not a name the user typed: a column of pulse
+    times that goes backwards is refused as ``--tach`` (``tach`` in the library)."""
+    from geardyn.diagnostics import diagnose_file
+    from geardyn.errors import InputError
+
+    t, _, acc, _ = _channels()
+    pulses = np.zeros_like(t)
+    pulses[:5] = [0.5, 0.4, 0.3, 0.2, 0.1]  # [s], going backwards
+    path = tmp_path / "bad.csv"
+    np.savetxt(path, np.c_[acc, pulses], delimiter=",", header="acc,tach", comments="")
+    line = one_error(run(tmp_path, path, "--signal", "acc", "--tach", "tach", "--tach-times",
+                         "--fs", FS, "--teeth", 25, "-o", tmp_path / "d"))
+    assert line.startswith("error: --tach: got 'non-increasing pulse times'"), line
+    assert "tach_times" not in line
+    with pytest.raises(InputError) as exc:
+        diagnose_file(path, signals="acc", tach="tach", tach_column_is_pulse_times=True, fs=FS,
+                      teeth=25)
+    assert exc.value.field == "tach"

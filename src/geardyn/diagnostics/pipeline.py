@@ -936,6 +936,24 @@ def diagnose_file(
                         units=m.units, source=str(path), **options)
     except ShortRecordError as exc:
         raise _short_record(path, m, exc, simulation) from None
+    except InputError as exc:
+        raise _renamed(exc, name_of) from None
+
+
+#: Arguments of :func:`diagnose` named by the :func:`diagnose_file` argument they come from
+#: (the pulse times from the ``tach`` channel), for the error messages of a file's diagnosis.
+_FILE_ARGUMENT_OF = {"tach_times": "tach", "angle": "angle", "fs": "fs", "time": "time",
+                     "teeth": "teeth", "pulses_per_rev": "pulses_per_rev"}
+
+
+def _renamed(exc: InputError, name_of) -> InputError:
+    """``exc`` of :func:`diagnose` with its field named as the caller of :func:`diagnose_file`
+    knows it (``tach_times`` -> ``tach``, or the command-line option ``--tach``); ``exc`` as it
+    is when nothing changes."""
+    parts = str(exc.field).split("/")
+    field = "/".join(name_of(_FILE_ARGUMENT_OF[p]) if p in _FILE_ARGUMENT_OF else p
+                     for p in parts)
+    return exc if field == exc.field else InputError(field, exc.value, exc.allowed)
 
 
 def _check_own_time_axis(path, time_axis: np.ndarray, fs, time, name_of) -> None:

@@ -168,7 +168,7 @@ def fig_load_sharing(m: StiffnessMap, dds: Sequence[float] = DEFAULT_DD, *,
 
 def fig_crack(healthy: StiffnessMap, cracked: StiffnessMap,
               dds: Sequence[float] = (0.0, 1.0e-3), *, theta_center: float | None = None,
-              n: int = 2000) -> Figure:
+              n: int = 2000, faulty: str = "cracked") -> Figure:
     """Fig. 6 analogue: healthy ``K00`` against the cracked pair at two centre distances.
 
     Parameters
@@ -181,6 +181,9 @@ def fig_crack(healthy: StiffnessMap, cracked: StiffnessMap,
         (:func:`crack_angle`).
     n : int
         Points per curve.
+    faulty : str
+        The legend's and title's word for the faulty pair: "cracked", or "faulty" where the
+        map holds other faults besides (or instead of) the crack.
     """
     tm = healthy.mesh_angle
     dds = _covered(cracked, dds)
@@ -199,10 +202,10 @@ def fig_crack(healthy: StiffnessMap, cracked: StiffnessMap,
                                                             abs_tol=1e-9) else "KC"
         extra = f", {depth * 1e3:g} mm crack" if depth is not None else ""
         ax.plot(np.degrees(th), cracked.torsional(th, d),
-                label=f"{name} (cracked, $\\Delta d$ = {d * 1e3:g} mm{extra})")
+                label=f"{name} ({faulty}, $\\Delta d$ = {d * 1e3:g} mm{extra})")
     ax.set_xlabel(r"pinion rolling angle $\theta$ [deg]")
     ax.set_ylabel(r"combined torsional mesh stiffness $K_t$ [N m/rad]")
-    ax.set_title(f"Healthy and cracked mesh stiffness ({cracked.attrs.get('method', '?')})")
+    ax.set_title(f"Healthy and {faulty} mesh stiffness ({cracked.attrs.get('method', '?')})")
     ax.grid(True, alpha=0.3)
     _legend_below(fig, ax, ncols=2)
     return fig

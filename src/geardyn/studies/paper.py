@@ -53,6 +53,7 @@ from .paper_values import (
     PAPER_VALUES,
     SIGNAL_KEYS,
     case_differences,
+    faulty_words,
 )
 
 __all__ = ["run_paper_study", "StudyResult", "PAPER_VALUES", "PAPER_TABLE2", "PAPER_TABLE3",
@@ -193,7 +194,8 @@ def stiffness_stage(case: Case, out: Path, result: StudyResult) -> None:
     dd_op = dd_op if cracked.covers(dd_op) else 0.0
     numbers = map_numbers(healthy, cracked, cracks, dd_op)
     if cracks:
-        result.figures.cached("fig6_crack", fig_crack, healthy, cracked)
+        result.figures.cached("fig6_crack", fig_crack, healthy, cracked,
+                              faulty=faulty_words(case)[0])
         result.summary["crack_angle_in_stiffness_deg"] = math.degrees(numbers["crack_angle_op"])
         result.summary["crack_angle_in_stiffness_at_mm"] = dd_op * 1e3
         result.crack_angle_rad = numbers["crack_angle_0"]
@@ -499,7 +501,9 @@ def simulation_stage(case: Case, out: Path, result: StudyResult) -> None:
     tc = float(tcs[0]) if tcs.size else float(t[0] + 0.5 * (t[-1] - t[0]))
     half = 0.55 * rev
     w8 = (max(t[0], tc - half), min(t[-1], tc + half))
-    result.figures.cached("fig8_design_parameters", pf.fig8_design_parameters, ds2, ca, w8)
+    faulty, fault = faulty_words(case)
+    result.figures.cached("fig8_design_parameters", pf.fig8_design_parameters, ds2, ca, w8,
+                          fault=fault)
     ds_s = runs[("II-start", "cracked")]
     ts = ds_s["time"].values
     tcs_s = pf.crack_times(ds_s, ca) if ca is not None else np.array([])
@@ -512,7 +516,7 @@ def simulation_stage(case: Case, out: Path, result: StudyResult) -> None:
     result.summary["model_comparison"] = model_comparison(runs)
     if result.summary["model_comparison"]:
         result.figures.cached("fig_model_comparison", pf.fig_model_comparison,
-                              result.summary["model_comparison"])
+                              result.summary["model_comparison"], faulty=faulty)
 
 
 #: Share of the samples whose differences :func:`model_comparison` reports the energy of
@@ -771,7 +775,7 @@ def measurement_stage(case: Case, out: Path, result: StudyResult) -> None:
                                             _map_case(case, result.quick), rec["record_s"])
     if "skipped" not in m and result.measured_tsa:
         result.figures.cached("fig24_measured_tsa", pf.fig_measured_tsa, result.measured_tsa,
-                              m["model"])
+                              m["model"], faulty=faulty_words(case)[0])
 
 
 def _report_stage(case: Case, out: Path, result: StudyResult) -> None:

@@ -57,9 +57,11 @@ def _plain_axis(ax) -> None:
     ax.ticklabel_format(axis="y", style="plain", useOffset=False)
 
 
-def fig8_design_parameters(ds, crack_angle: float | None, window: tuple[float, float]) -> Figure:
+def fig8_design_parameters(ds, crack_angle: float | None, window: tuple[float, float],
+                           fault: str = "crack") -> Figure:
     """Fig. 8 analogue: centre distance change, operating pressure angle and contact ratio of
-    model II against time from the start of the record, with the crack events marked.
+    model II against time from the start of the record, with the fault's events marked
+    (``fault``: the title's word for it, "crack" or "fault").
 
     The physical contact ratio and the paper's eq. 8 value differ by more than their
     variation, so each has its own panel (on one axis both would look flat)."""
@@ -83,7 +85,7 @@ def fig8_design_parameters(ds, crack_angle: float | None, window: tuple[float, f
             if window[0] <= tc <= window[1]:
                 for ax in axs:
                     ax.axvline(tc - t0, color="0.4", ls="--", lw=0.8)
-        axs[0].set_title("model II (crack events dashed)", fontsize=10)
+        axs[0].set_title(f"model II ({fault} events dashed)", fontsize=10)
     for ax in axs:
         ax.grid(alpha=0.3)
         _plain_axis(ax)
@@ -331,7 +333,7 @@ MEASURED_STYLE = {"ideal": ("black", 0.8, "ideal (no errors, no noise)"),
                   "errors+noise": ("#d62728", 0.6, "tooth errors + noise (realistic)")}
 
 
-def fig_measured_tsa(tsas: dict, model: str) -> Figure:
+def fig_measured_tsa(tsas: dict, model: str, faulty: str = "cracked") -> Figure:
     """TSA of the housing acceleration (tachometer TSA, in g) over one revolution of the
     tachometer's shaft, healthy (top) and cracked (bottom), for the measurement variants of
     :data:`MEASURED_STYLE` (:mod:`geardyn.studies.paper_measurement`).
@@ -342,6 +344,9 @@ def fig_measured_tsa(tsas: dict, model: str) -> Figure:
         ``(variant, state)`` -> TSA [m/s^2].
     model : str
         Model of the simulations (title).
+    faulty : str
+        The titles' word for the faulty state ("cracked", or "faulty" when the fault is not a
+        crack); the data's key stays ``"cracked"``.
     """
     g = 9.80665
     fig = _new_figure(figsize=(11.0, 6.0), layout="constrained")
@@ -353,7 +358,8 @@ def fig_measured_tsa(tsas: dict, model: str) -> Figure:
                 continue
             ang = np.arange(a.size) * 360.0 / a.size
             ax.plot(ang, a / g, lw=lw, color=color, label=label)
-        ax.set_title(f"model {model}, {state}: TSA of the housing acceleration (tachometer)",
+        shown = faulty if state == "cracked" else state
+        ax.set_title(f"model {model}, {shown}: TSA of the housing acceleration (tachometer)",
                      fontsize=9)
         ax.set_ylabel("acceleration [g]")
         ax.grid(alpha=0.3)
@@ -363,7 +369,7 @@ def fig_measured_tsa(tsas: dict, model: str) -> Figure:
     return fig
 
 
-def fig_model_comparison(comparison: dict) -> Figure:
+def fig_model_comparison(comparison: dict, faulty: str = "cracked") -> Figure:
     """RMS(II - I) / STD(II) and RMS(II - I-static) / STD(II) per signal, one panel per state.
 
     Parameters
@@ -371,6 +377,8 @@ def fig_model_comparison(comparison: dict) -> Figure:
     comparison : dict
         ``state -> {"signals": {signal: {"rms_ii_minus_i", "rms_ii_minus_i_static", ...}}}``
         (``summary["model_comparison"]`` of the study).
+    faulty : str
+        The titles' word for the state ``"cracked"`` ("faulty" when the fault is not a crack).
     """
     states = [st for st in ("cracked", "healthy") if st in comparison]
     fig = _new_figure(figsize=(10.0, 3.4 * max(1, len(states))), layout="constrained")
@@ -389,7 +397,8 @@ def fig_model_comparison(comparison: dict) -> Figure:
         ax.set_xticks(x)
         ax.set_xticklabels([n.replace("_", " ") for n in names], rotation=20, fontsize=8)
         ax.set_ylabel("% of STD(II)")
-        ax.set_title(f"{st} pair: distance of model I and model I-static from model II",
+        shown = faulty if st == "cracked" else st
+        ax.set_title(f"{shown} pair: distance of model I and model I-static from model II",
                      fontsize=9)
         ax.grid(alpha=0.3, which="both", axis="y")
         ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.0, 1.0))

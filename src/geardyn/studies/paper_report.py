@@ -27,6 +27,8 @@ from .paper_values import (
     SIGNAL_KEYS,
     SIGNAL_TITLES,
 )
+from .paper_values import fault_word as _fault_word
+from .paper_values import faulty_words as _faulty_words
 from .report import Report
 
 __all__ = ["report_stage", "write_results_netcdf", "ERRATA", "CITATIONS", "disagreements",
@@ -210,13 +212,6 @@ def _get(case: Case, key: str):
     if isinstance(node, list):
         return [v.model_dump() if hasattr(v, "model_dump") else v for v in node]
     return node
-
-
-def _faulty_words(case: Case) -> tuple[str, str]:
-    """``(adjective, noun)`` of the faulty state of the report: ("cracked", "crack") when the
-    case's fault is its crack alone, else ("faulty", "fault"). summary.json, results.nc and the
-    runs/ files keep the key "cracked" for that state whatever the fault."""
-    return ("cracked", "crack") if _fault_word(case) == "crack" else ("faulty", "fault")
 
 
 
@@ -540,16 +535,6 @@ def _fault_description(case: Case) -> str:
         parts.insert(0, f"{case.crack.depth * 1e3:g} mm root crack on {case.crack.gear} tooth "
                         f"{case.crack.tooth}")
     return ", ".join(parts) or "no fault: the same pair as the healthy one"
-
-
-def _fault_word(case: Case) -> str:
-    """What the narrowband envelope's peak locates: "crack", "fault", "faults" or "" (a healthy
-    pair: the peak then locates nothing)."""
-    n = len(getattr(case, "faults", None) or ())
-    crack = case.crack is not None and case.crack.active
-    if n == 0:
-        return "crack" if crack else ""
-    return "faults" if n + crack > 1 else "fault"
 
 
 def _short_value(value) -> str:

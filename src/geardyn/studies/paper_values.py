@@ -10,7 +10,8 @@ from __future__ import annotations
 from typing import Any
 
 __all__ = ["SIGNAL_KEYS", "SIGNAL_TITLES", "CONDITION_METRICS", "PAPER_TABLE2", "PAPER_TABLE3",
-           "PAPER_PM_LEVEL_DEG", "PAPER_VALUES", "NUMERICAL_KEYS", "case_differences"]
+           "PAPER_PM_LEVEL_DEG", "PAPER_VALUES", "NUMERICAL_KEYS", "case_differences",
+           "fault_word", "faulty_words"]
 
 #: The paper's names of the three signals (summary.json keys) by geardyn variable.
 SIGNAL_KEYS = {"v_yg": "gear_vertical_velocity", "omega_p": "pinion_angular_velocity",
@@ -143,3 +144,20 @@ def case_differences(case, reference=None) -> tuple[list[dict], list[dict]]:
         row = {"key": key, "paper": pa, "case": pb}
         (numerical if key in NUMERICAL_KEYS else inputs).append(row)
     return inputs, numerical
+
+
+def fault_word(case) -> str:
+    """What the narrowband envelope's peak locates: "crack", "fault", "faults" or "" (a healthy
+    pair: the peak then locates nothing)."""
+    n = len(getattr(case, "faults", None) or ())
+    crack = case.crack is not None and case.crack.active
+    if n == 0:
+        return "crack" if crack else ""
+    return "faults" if n + crack > 1 else "fault"
+
+
+def faulty_words(case) -> tuple[str, str]:
+    """``(adjective, noun)`` of the faulty state of the report: ("cracked", "crack") when the
+    case's fault is its crack alone, else ("faulty", "fault"). summary.json, results.nc and the
+    runs/ files keep the key "cracked" for that state whatever the fault."""
+    return ("cracked", "crack") if fault_word(case) == "crack" else ("faulty", "fault")
