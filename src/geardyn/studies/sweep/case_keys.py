@@ -9,7 +9,8 @@ from typing import Any, Literal
 
 from pydantic import BaseModel
 
-from ...config import Case, _dimension_of
+from ...config import Case
+from ...config.models import _dimension_of
 from ...errors import InputError
 from ...units import DIMENSIONS, to_si
 
