@@ -33,6 +33,9 @@ def short_repr(value: Any, limit: int = MAX_VALUE_CHARS) -> str:
     """
     if isinstance(value, str | bytes) and len(value) > limit:
         return repr(value[: limit // 2]) + f"… ({len(value)} characters)"
+    if type(value).__module__ == "numpy" and hasattr(value, "item") and getattr(
+            value, "ndim", 1) == 0:  # a NumPy scalar as the number it holds, not np.float64(...)
+        value = value.item()
     try:
         text = repr(value)
     except ValueError:  # int too long to convert

@@ -36,17 +36,19 @@ def test_band_limits_at_the_nyquist_and_mean_bounds():
         assert band_limits(10, 1, 9, 64) == (1, 19)  # K - B = 1: the lowest allowed
     err = _error(10, 5, 4, 108)  # K + B = 54 > 108 // 2 - 1 = 53
     assert err.field == "bandwidth" and err.value == 4
-    assert err.allowed == ("a band 50+/-B inside orders 1..53 (Nyquist is 54 orders for 108 "
-                           "samples per revolution); use a lower harmonic, smaller band or "
-                           "more samples")
+    assert err.allowed == ("a band 50+/-B (mesh harmonic 5 x 10 teeth) inside orders 1..53 "
+                           "(Nyquist is 54 orders for 108 samples per revolution); use a lower "
+                           "harmonic, smaller band or more samples (or check the tooth count)")
     # odd N: N // 2 - 1 (not N / 2 - 1)
     assert band_limits(10, 5, 4, 111) == (46, 54)
-    assert _error(10, 5, 5, 111).allowed.startswith("a band 50+/-B inside orders 1..54 ")
+    assert _error(10, 5, 5, 111).allowed.startswith(
+        "a band 50+/-B (mesh harmonic 5 x 10 teeth) inside orders 1..54 ")
 
 
 def test_band_touching_the_mean_is_refused_before_the_tooth_count_check():
     err = _error(10, 1, 10, 256)  # K - B = 0: reaches the mean (and B = Z)
-    assert err.allowed.startswith("a band 10+/-B inside orders 1..127 (Nyquist is 128 orders")
+    assert err.allowed.startswith("a band 10+/-B (mesh harmonic 1 x 10 teeth) inside orders "
+                                  "1..127 (Nyquist is 128 orders")
 
 
 def test_band_containing_the_neighbouring_harmonic():

@@ -179,7 +179,8 @@ def test_constant_record_message_names_the_metric(func, name):
     with pytest.warns(DiagnosticsWarning) as rec:
         assert math.isnan(func(np.full(8, 3.0)))
     assert [str(w.message) for w in rec] == [
-        f"{name}: constant signal (zero variance); returning NaN"]
+        f"{name}: constant signal (zero variance, or a variation at the round-off of its "
+        "values); returning NaN"]
 
 
 def test_kurtosis_can_be_silent_for_a_constant_record():
@@ -213,8 +214,9 @@ def test_signal_statistics_closed_form():
 def test_signal_statistics_of_zero_and_constant_records():
     with pytest.warns(DiagnosticsWarning) as rec:
         s = signal_statistics(np.zeros(5))
-    assert str(rec[0].message) == ("signal_statistics: constant signal (zero variance); "
-                                   "normalised statistics are NaN")
+    assert str(rec[0].message) == ("signal_statistics: constant signal (zero variance, or a "
+                                   "variation at the round-off of its values); normalised "
+                                   "statistics are NaN")
     assert (s.mean, s.std, s.rms, s.peak_to_peak, s.n) == (0.0, 0.0, 0.0, 0.0, 5)
     assert math.isnan(s.skewness) and math.isnan(s.kurtosis) and math.isnan(s.crest_factor)
     assert math.isnan(s.crest_factor_rms)
@@ -397,7 +399,9 @@ def test_condition_metrics_smallest_record_and_one_tooth():
         warnings.simplefilter("ignore", DiagnosticsWarning)  # difference signal empty
         condition_metrics(np.cos(2 * np.pi * np.arange(16) / 16), teeth=1)
     assert exc.value.field == "bandwidth"
-    assert exc.value.allowed.startswith("a band 1+/-B inside orders 1..7")  # reaches order 0
+    # reaches order 0
+    assert exc.value.allowed.startswith("a band 1+/-B (mesh harmonic 1 x 1 teeth) inside orders "
+                                        "1..7")
 
 
 def test_moments_of_values_near_the_float_limit():

@@ -6,6 +6,7 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
+from rich.markup import escape
 
 from . import app
 from ._common import (
@@ -23,6 +24,12 @@ OPTION_NAMES = {
     "signal": "--signal", "signals": "--signal", "teeth": "--teeth", "fs": "--fs",
     "time": "--time", "angle": "--angle", "angle_unit": "--angle-unit", "tach": "--tach",
     "tach_column_is_pulse_times": "--tach-times", "pulses_per_rev": "--pulses-per-rev",
+    "tach_edge": "--tach-edge", "tach_threshold": "--tach-threshold",
+    "tach_min_interval": "--tach-min-interval", "unwrap_angle": "--unwrap-angle",
+    # the diagnosis settings come from the case (--config, --set diagnostics.<key>=...)
+    "harmonic": "diagnostics.harmonic", "bandwidth": "diagnostics.bandwidth",
+    "samples_per_rev": "diagnostics.samples_per_rev",
+    "residual_preset": "diagnostics.residual_preset",
 }
 
 
@@ -58,11 +65,24 @@ def diagnose(
     angle: Annotated[str | None, typer.Option("--angle", help="Shaft angle column.",
                                               show_default=False)] = None,
     angle_unit: Annotated[str, typer.Option("--angle-unit", help="rad, deg or rev.")] = "rad",
+    unwrap_angle: Annotated[bool, typer.Option(
+        "--unwrap-angle", help="The angle column is wrapped (0..360 deg per turn, as an "
+                               "encoder's position reads): unwrap it.")] = False,
     tach: Annotated[str | None, typer.Option("--tach", help="Tachometer column (pulse train, or "
                                                             "pulse times with --tach-times).",
                                              show_default=False)] = None,
     tach_times: Annotated[bool, typer.Option("--tach-times", help="The tach column holds pulse "
                                                                   "times [s].")] = False,
+    tach_edge: Annotated[str, typer.Option(
+        "--tach-edge", help="Edge that marks a tach pulse: rising (active-high) or falling "
+                            "(active-low): the pulse's leading edge.")] = "rising",
+    tach_threshold: Annotated[float | None, typer.Option(
+        "--tach-threshold", help="Tach edge level, in the tach column's unit (default "
+                                 "mid-range).", show_default=False)] = None,
+    tach_min_interval: Annotated[str | None, typer.Option(
+        "--tach-min-interval", help="Shortest time between tach pulses [s], or with a unit "
+                                    "(e.g. '5 ms'): later edges closer than this are noise.",
+        show_default=False)] = None,
     pulses_per_rev: Annotated[int | None, typer.Option(
         "--pulses-per-rev", min=1, help="Tachometer pulses per revolution (default: the count "
                                         "the file states, as geardyn measure records it, else "
@@ -74,8 +94,8 @@ def diagnose(
 ) -> None:
     """Run TSA, spectra, residual, demodulation, PWVD and condition metrics; write figures and
     metrics.json into OUT."""
-    from ..errors import DataFileError
-    from ..units import parse_frequency
+    from ..errors import DataFileError, InputError
+    from ..units import parse_frequency, to_si
     from ._outputs import (
         begin,
         check_writable,
@@ -95,9 +115,19 @@ def diagnose(
     out = target.path
     check_writable(target)  # before loading anything heavy: a bad --out fails at once
     case = load_case_from_cli(config, set_)
+    if tach_edge not in ("rising", "falling"):
+        raise InputError("--tach-edge", tach_edge, "rising or falling")
+    min_interval = None
+    if tach_min_interval is not None:
+        min_interval = to_si(tach_min_interval, "time", "--tach-min-interval")  # [s]
+        if not min_interval > 0:
+            raise InputError("--tach-min-interval", tach_min_interval, "a positive time, e.g. "
+                             "'5 ms'")
     options = {"signal": signal or None, "teeth": teeth, "fs": fs, "time": time, "angle": angle,
                "angle_unit": angle_unit, "tach": tach, "tach_times": tach_times,
-               "pulses_per_rev": pulses_per_rev, "figures": figures}
+               "pulses_per_rev": pulses_per_rev, "figures": figures, "tach_edge": tach_edge,
+               "tach_threshold": tach_threshold, "tach_min_interval": min_interval,
+               "unwrap_angle": unwrap_angle}
     ident = identity("diagnose", case, options, files={"FILE": file})
     state = claim_folder(target, ident, force=force, results=["metrics.json", "figures"],
                          record=False)
@@ -109,6 +139,8 @@ def diagnose(
     result = diagnose_file(
         file, teeth=teeth, signals=signal or None, fs=fs, time=time, angle=angle, tach=tach,
         tach_column_is_pulse_times=tach_times, pulses_per_rev=pulses_per_rev,
+        tach_edge=tach_edge, tach_threshold=tach_threshold, tach_min_interval=min_interval,
+        unwrap_angle=unwrap_angle,
         angle_unit=angle_unit, default_teeth=case.pinion.teeth, option_names=OPTION_NAMES,
         samples_per_rev=d.samples_per_rev, harmonic=d.harmonic, bandwidth=d.bandwidth,
         residual_preset=d.residual_preset)
@@ -118,12 +150,22 @@ def diagnose(
     mark_complete(target, ident)
     summary = result.to_dict()
     written = "metrics.json and figures" if figures else "metrics.json"
-    console.print(f"[green]done[/green]: {written} in {out}/ (teeth {result.teeth})")
+    # names and paths are the user's text, not rich markup (a column "acc [/s]" closed a tag)
+    console.print(f"[green]done[/green]: {escape(written)} in {escape(str(out))}/ (teeth "
+                  f"{result.teeth})", soft_wrap=True)  # a path is not broken across lines
     def num(v) -> str:
         return f"{v:.4g}" if isinstance(v, int | float) else "n/a"
 
+    speed = result.settings.get("shaft_speed_rev_s")
+    at = ""
+    if speed:  # a wrong --pulses-per-rev or angle unit shows as a wrong speed
+        lo, hi = speed["min"], speed["max"]
+        at = (f" at {speed['mean']:.4g} rev/s ({60 * speed['mean']:.4g} rpm)"
+              if hi - lo <= 0.02 * speed["mean"] else
+              f" at {lo:.4g}-{hi:.4g} rev/s ({60 * lo:.4g}-{60 * hi:.4g} rpm)")
     for name, sig in summary.get("signals", {}).items():
         k = sig.get("kurtosis", {})
-        console.print(f"  {name}: {sig.get('n_averages')} revolutions averaged; kurtosis of TSA "
-                      f"{num(k.get('tsa'))}, residual {num(k.get('residual'))}, envelope "
-                      f"{num(k.get('envelope'))}, PM {num(k.get('phase_modulation'))}")
+        console.print(f"  {escape(str(name))}: {sig.get('n_averages')} revolutions averaged{at}; "
+                      f"kurtosis of TSA {num(k.get('tsa'))}, residual {num(k.get('residual'))}, "
+                      f"envelope {num(k.get('envelope'))}, PM "
+                      f"{num(k.get('phase_modulation'))}", soft_wrap=True)

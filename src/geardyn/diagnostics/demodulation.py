@@ -133,8 +133,9 @@ def band_limits(teeth: int, harmonic: int, bandwidth: int, samples_per_rev: int)
     if k + b > n // 2 - 1 or k - b < 1:
         raise InputError(
             "bandwidth", b,
-            f"a band {k}+/-B inside orders 1..{n // 2 - 1} (Nyquist is {n // 2} orders for "
-            f"{n} samples per revolution); use a lower harmonic, smaller band or more samples",
+            f"a band {k}+/-B (mesh harmonic {h} x {z} teeth) inside orders 1..{n // 2 - 1} "
+            f"(Nyquist is {n // 2} orders for {n} samples per revolution); use a lower "
+            "harmonic, smaller band or more samples (or check the tooth count)",
         )
     if b >= z:
         raise InputError(

@@ -32,6 +32,7 @@ CSV / text (``.csv``, ``.txt``, ``.tsv``, ``.dat``)
 from __future__ import annotations
 
 import contextlib
+import io
 import logging
 import os
 import re
@@ -43,6 +44,8 @@ from pathlib import Path
 import numpy as np
 
 from geardyn.errors import DataFileError, InputError
+
+from ..units import parse_frequency
 
 __all__ = ["DataTable", "read_table", "read_simulation", "TEXT_SUFFIXES", "NETCDF_SUFFIXES"]
 
@@ -67,12 +70,16 @@ class DataTable:
         Text entries of ``.mat`` files (``char`` variables and struct fields, dotted like the
         channels), NetCDF files (global attributes) and text files (``# key = value``
         comments), e.g. the ``case_toml`` a record of ``geardyn measure`` carries.
+    units : dict of str to str
+        Unit of a channel where the file states it (a NetCDF variable's ``units``); a column
+        named with its unit (``"acc [g]"``) is read by :func:`unit_in_name`.
     """
 
     path: str
     columns: dict[str, np.ndarray]
     scalars: dict[str, float] = field(default_factory=dict)
     text: dict[str, str] = field(default_factory=dict)
+    units: dict[str, str] = field(default_factory=dict)
 
     @property
     def names(self) -> list[str]:
@@ -171,10 +178,13 @@ def _read_text(p: Path) -> DataTable:
     if not body:
         raise DataFileError(p, "no data lines")
     first = body[0][1]
-    delim = "," if "," in first else ";" if ";" in first else "\t" if "\t" in first else None
+    # ';' first: a European spreadsheet writes ';' between fields and ',' in numbers
+    delim = ";" if ";" in first else "," if "," in first else "\t" if "\t" in first else None
+    decimal_comma = delim == ";" and any("," in ln and "." not in ln for _, ln in body[1:6])
 
     def split(line: str) -> list[str]:
-        return [t.strip() for t in (line.split(delim) if delim else line.split())]
+        toks = [t.strip() for t in (line.split(delim) if delim else line.split())]
+        return [t.replace(",", ".") for t in toks] if decimal_comma else toks
 
     head = split(first)
     header = None
@@ -189,8 +199,12 @@ def _read_text(p: Path) -> DataTable:
     data = None
     # fast path (C parser); the line loop below gives precise messages and NaN fields
     with contextlib.suppress(ValueError):
-        fast = np.loadtxt(p, delimiter=delim, comments="#", ndmin=2, encoding="utf-8-sig",
-                          skiprows=body[0][0] - 1, dtype=np.float64)
+        if decimal_comma:  # the C parser on the text with decimal points
+            fast = np.loadtxt(io.StringIO("\n".join(ln.replace(",", ".") for _, ln in body)),
+                              delimiter=delim, comments="#", ndmin=2, dtype=np.float64)
+        else:
+            fast = np.loadtxt(p, delimiter=delim, comments="#", ndmin=2, encoding="utf-8-sig",
+                              skiprows=body[0][0] - 1, dtype=np.float64)
         if fast.shape == (len(body), ncol):
             data = fast
     if data is None:
@@ -199,7 +213,8 @@ def _read_text(p: Path) -> DataTable:
     if len(set(names)) != len(names):
         raise DataFileError(p, f"duplicate column names in the header: {names}")
     scalars, text = _comment_entries(lines)
-    return DataTable(str(p), {n: data[:, j].copy() for j, n in enumerate(names)}, scalars, text)
+    return DataTable(str(p), {n: data[:, j].copy() for j, n in enumerate(names)}, scalars, text,
+                     _units_comment(lines, names))
 
 
 #: A ``# key = value`` comment line of a text file.
@@ -216,25 +231,88 @@ def _comment_entries(lines: list[str]) -> tuple[dict[str, float], dict[str, str]
         if m is None or m.group(1) in scalars or m.group(1) in text:
             continue
         key, value = m.group(1), m.group(2)
-        number = value[:-2].strip() if key == "fs" and value.endswith("Hz") else value
         try:
-            scalars[key] = float(number)
+            scalars[key] = float(value)
         except ValueError:
+            if is_rate_key(key):  # "# fs = 20 kHz", "# sample_rate = 51200 Hz"
+                try:
+                    scalars[key] = parse_frequency(value, key)
+                    continue
+                except ValueError:
+                    pass
             text[key] = value
     return scalars, text
 
+
+
+#: Names a file may give its sample rate [Hz], compared without case and underscores (``fs``,
+#: ``Fs``, ``FS``, ``sampleRate``, ``sample_rate``, ``SamplingRate``...; a struct field's last
+#: part, ``data.sampleRate``, counts too).
+RATE_KEYS = ("fs", "samplerate", "samplingrate", "samplingfrequency", "samplefrequency",
+             "srate", "fsample", "fsamp")
+
+
+def is_rate_key(key: str) -> bool:
+    """Whether ``key`` names a sample rate (:data:`RATE_KEYS`)."""
+    return str(key).rsplit(".", 1)[-1].replace("_", "").lower() in RATE_KEYS
+
+
+def stored_rate(scalars: dict) -> tuple[str, float] | None:
+    """The sample rate a file stores: ``(its name, value)``, ``fs`` first, else the first entry
+    whose name is a sample rate's (:data:`RATE_KEYS`); None if there is none."""
+    if "fs" in scalars:
+        return "fs", scalars["fs"]
+    for key, value in scalars.items():
+        if is_rate_key(key):
+            return key, value
+    return None
+
+
+_UNIT_IN_NAME = re.compile(r"[\[(]\s*([^\[\]()]{1,20}?)\s*[\])]\s*$")
+
+
+def unit_in_name(name: str) -> str:
+    """The unit a column name ends with, in brackets or parentheses (``"acc [g]"`` -> ``"g"``,
+    ``"force (N)"`` -> ``"N"``), else ``""``."""
+    m = _UNIT_IN_NAME.search(str(name))
+    return m.group(1) if m else ""
+
+
+_UNITS_COMMENT = re.compile(r"^\s*#\s*units\s*:\s*(.*)$", re.I)
+
+
+def _units_comment(lines: list[str], names: list[str]) -> dict[str, str]:
+    """Units of the columns from a ``# units: time [s], acc [m/s^2], ...`` comment line (as
+    ``geardyn measure --csv`` writes it): column name -> unit."""
+    for line in lines:
+        m = _UNITS_COMMENT.match(line)
+        if m is None:
+            continue
+        out = {}
+        for item in m.group(1).split(","):
+            item = item.strip()
+            unit = unit_in_name(item)
+            name = item[:item.rfind("[")].strip() if "[" in item else ""
+            if unit and name in names:
+                out[name] = unit
+        return out
+    return {}
 
 def _parse_lines(p: Path, body, ncol: int, split) -> np.ndarray:
     data = np.empty((len(body), ncol), dtype=np.float64)
     for r, (lineno, line) in enumerate(body):
         toks = split(line)
         if len(toks) != ncol:
+            what = ("lines before the column names (an acquisition system's preamble) must "
+                    "start with '#'" if r == 0 else "truncated or corrupt file?")
             raise DataFileError(p, f"line {lineno} has {len(toks)} fields, expected {ncol} "
-                                   "(truncated or corrupt file?)")
+                                   f"({what})")
         try:
             data[r] = [float(t) if t else np.nan for t in toks]
         except ValueError as exc:
-            raise DataFileError(p, f"line {lineno}: non-numeric value ({exc})") from exc
+            hint = ("; lines before the column names (an acquisition system's preamble) must "
+                    "start with '#'" if r == 0 else "")
+            raise DataFileError(p, f"line {lineno}: non-numeric value ({exc}){hint}") from exc
     return data
 
 
@@ -392,10 +470,13 @@ def _read_netcdf_table(p: Path) -> DataTable:
     cols: dict[str, np.ndarray] = {}
     scalars: dict[str, float] = {}
     text: dict[str, str] = {}
+    units: dict[str, str] = {}
     try:
         for name, var in {**dict(ds.coords), **dict(ds.data_vars)}.items():
             if var.ndim == 1 and var.dtype.kind in "biuf":
                 cols[str(name)] = np.asarray(var.values, dtype=np.float64)
+                if isinstance(var.attrs.get("units"), str) and var.attrs["units"].strip():
+                    units[str(name)] = var.attrs["units"].strip()
         for k, v in ds.attrs.items():
             if isinstance(v, int | float | np.integer | np.floating) and not isinstance(v, bool):
                 scalars[str(k)] = float(v)
@@ -405,7 +486,7 @@ def _read_netcdf_table(p: Path) -> DataTable:
         ds.close()
     if not cols:
         raise DataFileError(p, "no numeric 1-D variables")
-    return DataTable(str(p), cols, scalars, text)
+    return DataTable(str(p), cols, scalars, text, units)
 
 
 # --------------------------------------------------------------------------------------------

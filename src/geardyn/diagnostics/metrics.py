@@ -80,7 +80,29 @@ __all__ = [
     "nb4",
     "band_envelope",
     "energy_ratio",
+    "is_constant",
+    "CONSTANT_TOLERANCE",
 ]
+
+#: Relative variation below which a record counts as constant [-]: 1024 machine epsilons of its
+#: largest magnitude. Far below any acquisition's resolution (a 24-bit ADC resolves 6e-8 of its
+#: range) and above the round-off of averaging and filtering a constant (a stuck sensor's 0.25 g
+#: came out of the TSA varying by 2e-18 g, about 40 epsilons, and its kurtosis read 683).
+CONSTANT_TOLERANCE = 1024 * float(np.finfo(np.float64).eps)
+
+
+def is_constant(x) -> bool:
+    """Whether ``x`` is constant to round-off: ``max|x - mean| <= CONSTANT_TOLERANCE * max|x|``
+    (all zeros included). Its moment ratios (kurtosis, FM4, NA4...) would only measure the
+    round-off, so geardyn reports them as NaN."""
+    xa = np.asarray(x, dtype=np.float64)
+    if xa.size == 0:
+        return True
+    big = float(np.max(np.abs(xa)))
+    if big == 0.0:
+        return True
+    xs = xa / big  # |xs| <= 1: no overflow near the float limit
+    return float(np.max(np.abs(xs - xs.mean()))) <= CONSTANT_TOLERANCE
 
 
 def central_moment(x, order: int) -> float:
@@ -102,9 +124,10 @@ def _deviation_scaled(x: np.ndarray) -> tuple[np.ndarray, float]:
 def _normalised_moment(x: np.ndarray, order: int, name: str, warn: bool = True) -> float:
     z, _ = _deviation_scaled(x)
     m2 = float(np.mean(z * z))
-    if not m2 > 0:
+    if not m2 > 0 or is_constant(x):
         if warn:
-            warnings.warn(f"{name}: constant signal (zero variance); returning NaN",
+            warnings.warn(f"{name}: constant signal (zero variance, or a variation at the "
+                          "round-off of its values); returning NaN",
                           DiagnosticsWarning, stacklevel=3)
         return math.nan
     return float(np.mean(z**order)) / m2 ** (order / 2)
@@ -179,8 +202,9 @@ def signal_statistics(x) -> SignalStatistics:
     Returns
     -------
     SignalStatistics
-        See the class for units. Zero-variance input gives NaN for the normalised statistics
-        and a :class:`DiagnosticsWarning`.
+        See the class for units. Constant input (:func:`is_constant`: zero variance, or a
+        variation at the round-off of its values) gives NaN for the normalised statistics and
+        a :class:`DiagnosticsWarning`.
     """
     xa = _as_float_array(x, "x", min_size=2)
     # everything on x / max|x| (then scaled back), so no power overflows for huge signals
@@ -193,15 +217,18 @@ def signal_statistics(x) -> SignalStatistics:
     m2z = float(np.mean(z * z))
     rms_s = float(np.sqrt(np.mean(xs * xs)))
     rms = rms_s * scale
-    if m2z > 0:
+    if m2z > 0 and not is_constant(xs):
         std = math.sqrt(m2z) * dmax * scale
         skew = float(np.mean(z**3)) / m2z**1.5
         kurt = kurtosis(xs, warn_constant=False)
         cf = 1.0 / math.sqrt(m2z)
     else:
-        warnings.warn("signal_statistics: constant signal (zero variance); normalised "
-                      "statistics are NaN", DiagnosticsWarning, stacklevel=2)
-        std, skew, kurt, cf = 0.0, math.nan, math.nan, math.nan
+        warnings.warn("signal_statistics: constant signal (zero variance, or a variation at the "
+                      "round-off of its values); normalised statistics are NaN",
+                      DiagnosticsWarning, stacklevel=2)
+        # the STD as computed (0, or the round-off's), the ratios of round-off undefined
+        std = math.sqrt(m2z) * dmax * scale
+        skew, kurt, cf = math.nan, math.nan, math.nan
     cf_rms = float(np.max(np.abs(xs))) / rms_s if rms_s > 0 else math.nan
     return SignalStatistics(mean=mu, std=std, skewness=skew, kurtosis=kurt, crest_factor=cf,
                             crest_factor_rms=cf_rms, rms=rms,
@@ -531,6 +558,18 @@ def condition_metrics(
     """
     xa = _as_float_array(x, "x", min_size=8)
     z = _check_int(teeth, "teeth", 1, "a positive integer number of teeth")
+    if is_constant(xa):
+        # its difference, residual and envelope are round-off, whose moment ratios are any
+        # number (683 for a stuck sensor's 0.25 g): none of the metrics is defined
+        rms = float(np.sqrt(np.mean(xa * xa)))
+        warnings.warn(f"condition metrics: the TSA is constant (to round-off: varies by "
+                      f"{float(np.ptp(xa)):.3g} about {float(xa.mean()):.6g}); every metric but "
+                      "RMS and CrestFactor is NaN", DiagnosticsWarning, stacklevel=2)
+        return ConditionMetrics(
+            RMS=rms, Kurtosis=math.nan,
+            CrestFactor=float(np.max(np.abs(xa))) / rms if rms > 0 else math.nan,
+            FM4=math.nan, M6A=math.nan, M8A=math.nan, FM0=math.nan, EnergyRatio=math.nan,
+            NA4=math.nan, NA4star=math.nan, NB4=math.nan)
     y = regular(xa, teeth=z, shaft_harmonics=shaft_harmonics, mesh_harmonics=mesh_harmonics,
                 sidebands=0, include_dc=False)
     d = difference(xa, teeth=z, shaft_harmonics=shaft_harmonics, mesh_harmonics=mesh_harmonics,

@@ -29,6 +29,8 @@ from __future__ import annotations
 import json
 import math
 import os
+import re
+import warnings
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -39,17 +41,25 @@ import numpy as np
 from geardyn.errors import DataFileError, InputError
 
 from .demodulation import DemodulationResult, narrowband_demodulation
-from .io import NETCDF_SUFFIXES, read_simulation, read_table
+from .io import NETCDF_SUFFIXES, read_simulation, read_table, stored_rate, unit_in_name
 from .metrics import (
     ConditionMetrics,
     SignalStatistics,
     condition_metrics,
+    is_constant,
     kurtosis,
     signal_statistics,
 )
 from .spectra import OrderSpectrum, difference, order_spectrum, regular, residual
 from .tfd import PWVDResult, pwvd
-from .tsa import ShortRecordError, TSAResult, _check_int, tach_pulse_times, tsa
+from .tsa import (
+    DiagnosticsWarning,
+    ShortRecordError,
+    TSAResult,
+    _check_int,
+    tach_pulse_times,
+    tsa,
+)
 
 __all__ = [
     "SIMULATION_SIGNALS",
@@ -186,6 +196,8 @@ def load_measurement(
     tach_column_is_pulse_times: bool = False,
     pulses_per_rev: int | None = None,
     tach_threshold: float | None = None,
+    tach_edge: str = "rising",
+    tach_min_interval: float | None = None,
     angle_unit: str = "rad",
     unwrap_angle: bool = False,
     units: Mapping[str, str] | None = None,
@@ -232,6 +244,12 @@ def load_measurement(
         contradicts the file's is refused.
     tach_threshold : float, optional
         Edge threshold of a sampled pulse train (unit of the column).
+    tach_edge : {"rising", "falling"}
+        The edge that marks a pulse of a sampled pulse train: its leading edge ("falling"
+        for an active-low tachometer).
+    tach_min_interval : float, optional
+        Shortest time between two pulses [s]: edges closer than this to the last one kept
+        (noise on a slow edge, chatter) are dropped.
     angle_unit : {"rad", "deg", "rev"}
         Unit of the angle column.
     unwrap_angle : bool
@@ -275,7 +293,8 @@ def load_measurement(
         raise InputError(fs_, f"{fs:.10g} Hz",
                          f"no {fs_} together with {time_} (the times of column {time!r} "
                          f"would be used): give one of them")
-    stored_fs = table.scalars.get("fs")
+    rate_entry = stored_rate(table.scalars)  # fs, Fs, sampleRate, data.sample_rate...
+    rate_key, stored_fs = rate_entry if rate_entry is not None else ("fs", None)
     if stored_fs is not None and np.isfinite(stored_fs) and stored_fs > 0:
         if fs is not None and not _same_rate(fs, stored_fs):
             raise InputError(fs_, f"{fs:.10g} Hz",
@@ -284,14 +303,18 @@ def load_measurement(
         if time is None:
             fs = stored_fs
     elif stored_fs is not None and fs is None and time is None:
-        raise DataFileError(path, f"stores a sample rate fs = {stored_fs:g}, not a positive "
-                                  f"number of Hz: give the rate ({fs_}) or a time column "
-                                  f"({time_})")
+        raise DataFileError(path, f"stores a sample rate {rate_key} = {stored_fs:g}, not a "
+                                  f"positive number of Hz: give the rate ({fs_}) or a time "
+                                  f"column ({time_})")
     t = None if time is None else table.get(time, time_)
     if fs is None and t is None:
+        timelike = [c for c in table.names
+                    if re.match(r"(?i)^\s*(time|t)\b", c) and c not in signals]
+        hint = (f" (its column{'s' if len(timelike) > 1 else ''} "
+                + ", ".join(repr(c) for c in timelike[:3]) + f" for {time_}?)" if timelike else "")
         raise InputError(f"{fs_}/{time_}", "neither",
                          f"a sample rate in Hz ({fs_}) or a time column ({time_}): "
-                         f"{file_name} stores no sample rate")
+                         f"{file_name} stores no sample rate{hint}")
 
     if (angle is None) == (tach is None):
         raise InputError(f"{name_of('angle')}/{name_of('tach')}",
@@ -299,16 +322,27 @@ def load_measurement(
                          "exactly one of an angle column or a tachometer column")
     ang = None
     tach_times = None
+    sampled_train = (("tach_edge", tach_edge, "rising"), ("tach_threshold", tach_threshold, None),
+                     ("tach_min_interval", tach_min_interval, None))
     for key, value, idle in (("tach_column_is_pulse_times", tach_column_is_pulse_times, False),
-                             ("pulses_per_rev", pulses_per_rev, None)):
+                             ("pulses_per_rev", pulses_per_rev, None), *sampled_train):
         if angle is not None and value != idle:  # tachometer options with an angle channel
             raise InputError(name_of(key), value, f"no {name_of(key)} with an "
                              f"{name_of('angle')} channel (it applies to a {name_of('tach')} "
                              "channel)")
+    for key, value, idle in sampled_train:
+        if tach_column_is_pulse_times and value != idle:  # edges of a train, not given times
+            raise InputError(name_of(key), value, f"no {name_of(key)} with "
+                             f"{name_of('tach_column_is_pulse_times')}: it finds the edges of a "
+                             "sampled pulse train, and the column already lists pulse times")
     if angle is None and angle_unit != "rad":  # the tachometer's angle has no unit to give
         raise InputError(name_of("angle_unit"), angle_unit,
                          f"no {name_of('angle_unit')} with a tachometer channel (it is the unit "
                          f"of an {name_of('angle')} channel)")
+    if angle is None and unwrap_angle:
+        raise InputError(name_of("unwrap_angle"), True,
+                         f"no {name_of('unwrap_angle')} with a tachometer channel (it unwraps "
+                         f"an {name_of('angle')} channel)")
     if angle is not None:
         scale = {"rad": 1.0, "deg": np.pi / 180.0, "rev": 2.0 * np.pi}.get(angle_unit)
         if scale is None:
@@ -328,11 +362,16 @@ def load_measurement(
         if tach_column_is_pulse_times:
             tach_times = col[np.isfinite(col)]
         else:
-            tach_times = tach_pulse_times(col, fs=None if t is not None else fs, time=t,
-                                          threshold=tach_threshold)
+            tach_times = _pulse_times(col, fs=None if t is not None else fs, time=t,
+                                      threshold=tach_threshold, edge=tach_edge,
+                                      min_interval=tach_min_interval, name_of=name_of)
         if tach_times.size < 2:
+            level = ("" if tach_column_is_pulse_times else
+                     f" at the threshold {_threshold(col, tach_threshold):.6g} (the tach's "
+                     f"{'mid-range' if tach_threshold is None else 'given level'}; a spike "
+                     f"lifts the mid-range: set {name_of('tach_threshold')})")
             raise InputError(name_of("tach"), tach, "a tachometer channel with at least 2 "
-                                                    f"pulses (found {tach_times.size})")
+                                                    f"pulses (found {tach_times.size}{level})")
     for name, arr in [*signals.items(), (time_, t), (name_of("angle"), ang)]:
         if arr is not None and arr.shape[0] != n:
             raise InputError(name, f"{arr.shape[0]} samples", f"{n} samples like the signal")
@@ -343,9 +382,54 @@ def load_measurement(
     return Measurement(signals=signals, fs=None if fs is None else float(fs), time=t,
                        angle=ang, tach_times=tach_times, pulses_per_rev=ppr,
                        teeth=_stored_teeth(table.scalars, table.text, shaft),
-                       units={k: (units or {}).get(k, "") for k in signals},
+                       # the unit given, else the file's (NetCDF units), else the name's
+                       units={k: (units or {}).get(k) or table.units.get(k)
+                              or table.text.get(f"units.{k}", "") or unit_in_name(k)
+                              for k in signals},
                        source=str(path))
 
+
+
+def _threshold(col: np.ndarray, given: float | None) -> float:
+    """The tach's edge level: ``given``, else mid-range (as :func:`tach_pulse_times`)."""
+    return float(given) if given is not None else 0.5 * (float(np.min(col)) + float(np.max(col)))
+
+
+def _pulse_times(col, *, fs, time, threshold, edge, min_interval, name_of) -> np.ndarray:
+    """:func:`tach_pulse_times` of a file's tach column, its errors named as the caller knows
+    the options, and a pulse train whose pulses come irregularly (noise on a slow edge counted
+    as extra pulses) refused with what to set, before the TSA fails on it."""
+    finite = col[np.isfinite(col)]
+    if finite.size < col.size and finite.size >= 2 and np.all(np.diff(finite) > 0):
+        # increasing numbers padded with NaN: a list of pulse times, not a sampled pulse train
+        raise InputError(name_of("tach"), f"{finite.size} increasing values and "
+                         f"{col.size - finite.size} NaN",
+                         "a sampled pulse train; the column looks like a list of pulse times "
+                         f"[s]: pass {name_of('tach_column_is_pulse_times')}")
+    try:
+        times = tach_pulse_times(col, fs=fs, time=time, threshold=threshold,
+                                 min_interval=min_interval, edge=edge)
+    except InputError as exc:
+        field = {"threshold": "tach_threshold", "min_interval": "tach_min_interval",
+                 "edge": "tach_edge"}.get(exc.field, exc.field)
+        raise InputError(name_of(field), exc.value, exc.allowed) from None
+    if times.size >= 4:
+        # a pulse less than half its neighbours' interval after the one before: chatter, not
+        # a speed change (a run-up changes the interval by a small factor from pulse to pulse)
+        gaps = np.diff(times)
+        neighbour = np.maximum(np.r_[gaps[1], gaps[:-1]], np.r_[gaps[1:], gaps[-2]])
+        is_short = gaps < 0.5 * neighbour
+        short = int(np.count_nonzero(is_short))
+        if short:
+            med = float(np.median(gaps[~is_short])) if short < gaps.size else float(gaps.max())
+            raise InputError(
+                name_of("tach"), f"{times.size} pulses, {short} too soon",
+                f"a pulse train with one edge per pulse ({short} pulses came less than half "
+                "their neighbours' interval after the one before: noise on a slow edge, or a "
+                f"second edge, crosses the threshold {_threshold(col, threshold):.6g} again); "
+                f"set {name_of('tach_min_interval')} (e.g. {0.5 * med:.3g} s, half the "
+                f"regular interval), {name_of('tach_threshold')} or {name_of('tach_edge')}")
+    return times
 
 def _namer(option_names: Mapping[str, str] | None) -> Callable[[str], str]:
     """``name_of(argument)``: the name an error message gives an argument (its own by
@@ -781,6 +865,10 @@ def diagnose(
         one = TSAResult(average=avg, angle=t_res.angle, n_averages=t_res.n_averages,
                         samples_per_rev=n, start_angle=t_res.start_angle,
                         oversampling=t_res.oversampling, method=t_res.method)
+        flat = is_constant(avg)
+        spectrum = order_spectrum(avg, scaling="rms")
+        if not flat:
+            _warn_if_not_meshing(spectrum, z, name)
         res = residual(avg, teeth=z, preset=residual_preset)
         dem = narrowband_demodulation(avg, teeth=z, harmonic=harmonic, bandwidth=bandwidth,
                                       remove_mean_phase=remove_mean_phase,
@@ -789,7 +877,7 @@ def diagnose(
             name=name,
             unit=units.get(name, ""),
             tsa=one,
-            spectrum=order_spectrum(avg, scaling="rms"),
+            spectrum=spectrum,
             residual=res,
             regular=regular(avg, teeth=z),
             difference=difference(avg, teeth=z),
@@ -799,10 +887,11 @@ def diagnose(
             pwvd_residual=pwvd(res, window_length=pwvd_window_length, max_order=max_order,
                                distribution=pwvd_distributions),
             statistics=signal_statistics(avg),
-            residual_kurtosis=kurtosis(res, warn_constant=False),
-            envelope_kurtosis=kurtosis(dem.envelope, warn_constant=False),
-            am_kurtosis=kurtosis(dem.am, warn_constant=False),
-            pm_kurtosis=kurtosis(dem.pm, warn_constant=False),
+            # of a constant TSA (a stuck sensor) these are moments of round-off: NaN
+            residual_kurtosis=math.nan if flat else kurtosis(res, warn_constant=False),
+            envelope_kurtosis=math.nan if flat else kurtosis(dem.envelope, warn_constant=False),
+            am_kurtosis=math.nan if flat else kurtosis(dem.am, warn_constant=False),
+            pm_kurtosis=math.nan if flat else kurtosis(dem.pm, warn_constant=False),
             metrics=condition_metrics(avg, teeth=z, residual_preset=residual_preset),
         )
     return DiagnosisResult(
@@ -811,6 +900,9 @@ def diagnose(
         source=source,
         settings={
             "n_averages": t_res.n_averages,
+            "shaft_speed_rev_s": shaft_speed(angle=angle, tach_times=tach_times,
+                                             pulses_per_rev=pulses_per_rev, fs=fs, time=time,
+                                             n=next(iter(lengths))),
             "start_angle_rad": t_res.start_angle,
             "antialias_oversampling": t_res.oversampling,
             "pulses_per_rev": int(pulses_per_rev) if tach_times is not None else None,
@@ -824,6 +916,65 @@ def diagnose(
     )
 
 
+
+
+#: How much the strongest order of a TSA (from order 3, above the shaft orders of runout and
+#: eccentricity) must exceed every mesh harmonic, when it is not one, for :func:`diagnose` to
+#: doubt the number of teeth [-].
+NOT_MESHING_FACTOR = 3.0
+
+
+def _warn_if_not_meshing(spectrum, teeth: int, name: str) -> None:
+    """Warn when a TSA's strongest order (>= 3) is not a multiple of ``teeth`` and exceeds its
+    largest mesh harmonic :data:`NOT_MESHING_FACTOR` times: a wrong tooth count puts the mesh
+    order (and every metric built on it) in the wrong place, without any other sign."""
+    amp = np.asarray(spectrum.amplitude, dtype=float)
+    if amp.size <= max(3, teeth):
+        return
+    k = 3 + int(np.argmax(amp[3:]))
+    mesh = amp[teeth::teeth]
+    if k % teeth and mesh.size and amp[k] > NOT_MESHING_FACTOR * float(mesh.max()):
+        warnings.warn(f"{name}: the TSA's strongest order is {k}, not a multiple of the mesh "
+                      f"order {teeth} ({amp[k] / float(mesh.max()):.3g} times its largest mesh "
+                      f"harmonic): has the gear on the averaged shaft {teeth} teeth? A "
+                      "gear mesh puts its order at a multiple of the tooth count",
+                      DiagnosticsWarning, stacklevel=3)
+
+def shaft_speed(*, angle=None, tach_times=None, pulses_per_rev: int = 1, fs=None, time=None,
+                n: int) -> dict | None:
+    """Speed of the averaged shaft over the record [rev/s]: ``{"mean", "min", "max"}``, the
+    extremes over whole revolutions (from the pulses, ``pulses_per_rev`` at a time, or from the
+    angle's crossings of whole turns); None when the record holds no whole revolution.
+
+    Printed beside the number of averaged revolutions (``geardyn diagnose``) so that a wrong
+    ``pulses_per_rev`` or angle unit shows as a wrong speed. Arguments as for :func:`diagnose`
+    (already checked by its TSA); ``n`` is the number of samples. An angle channel without
+    sample times (no ``fs``, no ``time``) has no speed: None.
+    """
+    if tach_times is not None:
+        tt = np.asarray(tach_times, dtype=np.float64)
+        tt = tt[np.isfinite(tt)]
+        k = int(pulses_per_rev)
+        if tt.size <= k:
+            return None
+        per_rev = tt[k:] - tt[:-k]  # [s] per revolution, pulse to pulse
+        mean = (tt.size - 1) / k / float(tt[-1] - tt[0])
+    else:
+        if fs is None and time is None:  # an angle without times: no speed to tell
+            return None
+        a = np.asarray(angle, dtype=np.float64)
+        t = (np.arange(n) / float(fs)) if time is None else np.asarray(time, dtype=np.float64)
+        turns = (a - a[0]) / (2 * math.pi)
+        if turns[-1] < 1.0:
+            return None
+        crossings = np.interp(np.arange(0.0, math.floor(turns[-1]) + 1.0), turns, t)
+        per_rev = np.diff(crossings)
+        mean = float(turns[-1]) / float(t[-1] - t[0])
+    speeds = 1.0 / per_rev[per_rev > 0]
+    if speeds.size == 0:
+        return None
+    return {"mean": float(mean), "min": float(speeds.min()), "max": float(speeds.max())}
+
 def diagnose_file(
     path,
     *,
@@ -836,6 +987,8 @@ def diagnose_file(
     tach_column_is_pulse_times: bool = False,
     pulses_per_rev: int | None = None,
     tach_threshold: float | None = None,
+    tach_edge: str = "rising",
+    tach_min_interval: float | None = None,
     angle_unit: str = "rad",
     unwrap_angle: bool = False,
     default_teeth: int | None = None,
@@ -860,7 +1013,7 @@ def diagnose_file(
     signals : str, int or sequence, optional
         Signals to diagnose.
     fs, time, angle, tach, tach_column_is_pulse_times, pulses_per_rev, tach_threshold,
-    angle_unit, unwrap_angle
+    tach_edge, tach_min_interval, angle_unit, unwrap_angle
         See :func:`load_measurement`.
     default_teeth : int, optional
         Z [-] for measured data whose file does not say it (the command line passes its case's
@@ -900,7 +1053,11 @@ def diagnose_file(
         # the exact angle theta_p: the options of a measured angle would be ignored silently
         for key, value, idle in (("tach_column_is_pulse_times", tach_column_is_pulse_times,
                                   False), ("pulses_per_rev", pulses_per_rev, None),
-                                 ("angle_unit", angle_unit, "rad")):
+                                 ("angle_unit", angle_unit, "rad"), ("tach_edge", tach_edge,
+                                                                     "rising"),
+                                 ("unwrap_angle", unwrap_angle, False),
+                                 ("tach_threshold", tach_threshold, None),
+                                 ("tach_min_interval", tach_min_interval, None)):
             if value != idle:
                 raise InputError(name_of(key), value,
                                  f"no {name_of(key)} for a geardyn simulation result: "
@@ -914,6 +1071,7 @@ def diagnose_file(
         m = load_measurement(path, signal=signals, fs=fs, time=time, angle=angle, tach=tach,
                              tach_column_is_pulse_times=tach_column_is_pulse_times,
                              pulses_per_rev=pulses_per_rev, tach_threshold=tach_threshold,
+                             tach_edge=tach_edge, tach_min_interval=tach_min_interval,
                              angle_unit=angle_unit, unwrap_angle=unwrap_angle,
                              option_names=option_names)
     if teeth is not None and m.teeth is not None and int(teeth) != m.teeth:
@@ -943,7 +1101,9 @@ def diagnose_file(
 #: Arguments of :func:`diagnose` named by the :func:`diagnose_file` argument they come from
 #: (the pulse times from the ``tach`` channel), for the error messages of a file's diagnosis.
 _FILE_ARGUMENT_OF = {"tach_times": "tach", "angle": "angle", "fs": "fs", "time": "time",
-                     "teeth": "teeth", "pulses_per_rev": "pulses_per_rev"}
+                     "teeth": "teeth", "pulses_per_rev": "pulses_per_rev",
+                     "harmonic": "harmonic", "bandwidth": "bandwidth",
+                     "samples_per_rev": "samples_per_rev", "residual_preset": "residual_preset"}
 
 
 def _renamed(exc: InputError, name_of) -> InputError:

@@ -71,7 +71,8 @@ def plot_tsa(tsa, *, label: str = "signal", unit: str = "", title: str | None = 
     ax.set_xlim(0, 360)
     ax.set_xticks(np.arange(0, 361, 45))
     ax.set_xlabel("shaft angle [deg]")
-    ax.set_ylabel(label + _unit(unit))
+    # a column named with its unit ("acc [g]") keeps it once
+    ax.set_ylabel(label if unit and label.rstrip().endswith(f"[{unit}]") else label + _unit(unit))
     ax.set_title(title or default)
     ax.grid(True, alpha=0.3)
     return fig

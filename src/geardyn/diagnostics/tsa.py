@@ -127,7 +127,7 @@ def _check_finite(arr: np.ndarray, name: str) -> None:
         bad = np.argwhere(~finite)[0]
         idx = tuple(int(i) for i in bad)
         where = idx[0] if len(idx) == 1 else idx
-        raise InputError(name, f"non-finite value {arr[tuple(bad)]!r} at index {where}",
+        raise InputError(name, f"non-finite value {float(arr[tuple(bad)])!r} at index {where}",
                          "finite numbers only (no NaN or inf); trim or repair the record")
 
 
@@ -329,7 +329,8 @@ def _check_angle(angle: np.ndarray, name: str, unwrap: bool
                        "(and expect orders to be mirrored)")
         elif np.any(np.abs(d + TWO_PI) < 0.5) and not unwrap:
             allowed = ("a strictly increasing (unwrapped) shaft angle; this one jumps by about "
-                       "-2*pi: it looks wrapped, pass unwrap=True")
+                       "-2*pi: it looks wrapped (unwrap it: tsa(unwrap=True), "
+                       "diagnose_file(unwrap_angle=True), geardyn diagnose --unwrap-angle)")
         else:
             allowed = "a strictly increasing (unwrapped) shaft angle"
         raise InputError(
@@ -345,10 +346,11 @@ def _check_angle(angle: np.ndarray, name: str, unwrap: bool
 # --------------------------------------------------------------------------------------------
 def tach_pulse_times(signal, *, fs: float | None = None, time=None,
                      threshold: float | None = None,
-                     min_interval: float | None = None) -> np.ndarray:
-    """Times of the rising edges of a sampled tachometer pulse train.
+                     min_interval: float | None = None, edge: str = "rising") -> np.ndarray:
+    """Times of the rising (or falling) edges of a sampled tachometer pulse train.
 
-    A rising edge is a crossing of ``threshold`` from below between samples ``i-1`` and ``i``;
+    A rising edge is a crossing of ``threshold`` from below between samples ``i-1`` and ``i``
+    (a falling edge, ``edge="falling"``, from above: the leading edge of an active-low pulse);
     its time is located by linear interpolation between the two samples (sub-sample accuracy):
 
     .. math:: t_e = t_{i-1} + (t_i - t_{i-1}) (c - s_{i-1}) / (s_i - s_{i-1}).
@@ -367,6 +369,11 @@ def tach_pulse_times(signal, *, fs: float | None = None, time=None,
     min_interval : float, optional
         Minimum time between accepted edges [s]; later edges closer than this to the previous
         accepted edge (noise chatter) are discarded. Default: no filtering.
+    edge : {"rising", "falling"}
+        Which edge marks the pulse: ``"rising"`` (an active-high pulse) or ``"falling"`` (an
+        active-low one). The pulse's *leading* edge is the one to give: a pulse of fixed
+        duration (a one-shot sensor output) puts its trailing edge at an angle that moves with
+        the speed, which smears a run-up's TSA.
 
     Returns
     -------
@@ -388,15 +395,19 @@ def tach_pulse_times(signal, *, fs: float | None = None, time=None,
         the linear crossing) or give counter time stamps of the pulses.
     """
     s = _as_float_array(signal, "tach", min_size=2)
+    if edge not in ("rising", "falling"):
+        raise InputError("edge", edge, "'rising' or 'falling'")
     t = _sample_times(s.shape[0], fs, time)
     c = 0.5 * (s.min() + s.max()) if threshold is None else float(threshold)
     if not s.min() < c <= s.max():
         raise InputError("threshold", c, f"a level between the tach minimum {s.min():.6g} and "
                          f"maximum {s.max():.6g}")
+    if edge == "falling":  # the falling edges of s are the rising edges of -s at -c
+        s, c = -s, -c
     i = np.flatnonzero((s[:-1] < c) & (s[1:] >= c)) + 1
     frac = (c - s[i - 1]) / (s[i] - s[i - 1])
     edges = t[i - 1] + frac * (t[i] - t[i - 1])
-    _warn_unresolved_edges(s, i)
+    _warn_unresolved_edges(s, i, edge)
     if min_interval is not None and edges.size > 1:
         if not min_interval > 0:
             raise InputError("min_interval", min_interval, "a positive time in s")
@@ -408,8 +419,9 @@ def tach_pulse_times(signal, *, fs: float | None = None, time=None,
     return edges
 
 
-def _warn_unresolved_edges(s: np.ndarray, i: np.ndarray) -> None:
-    """Warn when most rising edges jump from the low to the high level in one sample."""
+def _warn_unresolved_edges(s: np.ndarray, i: np.ndarray, edge: str = "rising") -> None:
+    """Warn when most edges jump from one level to the other in one sample (``s`` as searched:
+    a falling edge's signal negated)."""
     if i.size == 0:
         return
     lo, hi = float(s.min()), float(s.max())
@@ -422,7 +434,7 @@ def _warn_unresolved_edges(s: np.ndarray, i: np.ndarray) -> None:
     if np.count_nonzero(jumps) > 0.5 * i.size:
         warnings.warn(
             f"tach edges are not resolved by the sampling ({np.count_nonzero(jumps)} of "
-            f"{i.size} rising edges jump from the low to the high level between two samples): "
+            f"{i.size} {edge} edges jump from one level to the other between two samples): "
             "each pulse time is known only to +/- half a sample, which lowers the TSA "
             "amplitude of an order at f cycles per sample by up to 1 - sinc(f) (0.8 % at "
             "0.07 fs, 1.6 % at 0.1 fs). Record the tach through the anti-alias filter, or "
