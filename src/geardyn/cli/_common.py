@@ -22,7 +22,7 @@ from rich.markup import escape
 
 from ..errors import GeardynError
 
-__all__ = ["ConfigOption", "SetOption", "OutOption", "ForceOption", "refuse_overwrite",
+__all__ = ["ConfigOption", "SetOption", "OutOption", "ForceOption",
            "load_case_from_cli", "handle_errors", "one_line", "warning_line", "choice",
            "console", "err_console", "progress_bar", "StageProgress", "MAX_ERROR_CHARS"]
 
@@ -66,17 +66,6 @@ def choice(option: str, value: str | None, allowed: tuple[str, ...]) -> str | No
         if value.strip().lower() == a.lower():
             return a
     raise InputError(option, value, " or ".join(repr(a) for a in allowed) + " (any case)")
-
-
-def refuse_overwrite(paths, force: bool, option: str = "--out") -> None:
-    """Raise an InputError naming ``option`` if any of ``paths`` exists and not ``force``."""
-    from ..errors import InputError
-
-    existing = [str(p) for p in paths if Path(p).exists()]
-    if existing and not force:
-        raise InputError(option, existing[0], "a path with no earlier result in it (it exists; "
-                                              "pass --force to overwrite, or choose another "
-                                              f"{option})")
 
 
 def load_case_from_cli(config: Path | None, overrides: list[str] | None):

@@ -30,6 +30,7 @@ from ..errors import InputError
 
 __all__ = ["OutputTarget", "OutputInUse", "RECORD", "identity", "check_writable", "claim_folder", "begin",
            "mark_complete", "read_record", "differences", "refuse_different", "resolve",
+           "recorded_inputs", "claim_file",
            "cache_summary", "say_state", "say_cache"]
 
 #: Name of the inputs record in an output folder.
@@ -168,6 +169,50 @@ def refuse_different(target: OutputTarget, diff: list[str]) -> InputError:
     return OutputInUse(target.label, f"holds results of different inputs ({shown})",
                        "pass --force to replace them, or choose another output with --out")
 
+
+
+def recorded_inputs(path: Path) -> dict[str, Any] | None:
+    """The inputs identity (:func:`identity`) a geardyn NetCDF output carries in its
+    ``geardyn_inputs`` attribute; None for a file that is not one (or unreadable)."""
+    import json
+
+    import h5py
+
+    try:
+        with h5py.File(path, "r") as f:
+            text = f.attrs.get("geardyn_inputs")
+        text = text.decode() if isinstance(text, bytes) else text
+        ident = json.loads(text) if text else None
+    except (OSError, ValueError, TypeError):
+        return None
+    return ident if isinstance(ident, dict) else None
+
+
+def claim_file(target: OutputTarget, ident: dict[str, Any], *, force: bool,
+               companions: tuple[Path, ...] = ()) -> bool:
+    """Whether the NetCDF output ``target`` (written atomically, with its inputs in the
+    ``geardyn_inputs`` attribute) already holds the results of ``ident`` with its
+    ``companions`` beside it: then there is nothing to compute (True). A file of other inputs,
+    or one geardyn did not write, is refused without ``force`` (:class:`OutputInUse`); so is a
+    companion file where the output itself is missing."""
+    path = target.path
+    if not path.exists():
+        present = [c for c in companions if c.exists()]
+        if present and not force:
+            raise OutputInUse(target.label, f"has no result but {present[0]} exists",
+                              "pass --force to replace it, or choose another output with --out")
+        return False
+    old = recorded_inputs(path)
+    if old is None:
+        if not force:
+            raise OutputInUse(target.label, "is an existing file that is not a geardyn result "
+                                            "of known inputs",
+                              "pass --force to replace it, or choose another file with --out")
+        return False
+    diff = differences(old, ident)
+    if diff and not force:
+        raise refuse_different(target, diff)
+    return not diff and not force and all(c.exists() for c in companions)
 
 def check_writable(target: OutputTarget, *, folder: bool = True) -> None:
     """Refuse, before any work, an output that cannot be written.

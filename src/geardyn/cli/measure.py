@@ -19,7 +19,6 @@ from ._common import (
     handle_errors,
     load_case_from_cli,
     progress_bar,
-    refuse_overwrite,
 )
 
 #: Default output file of ``geardyn measure``.
@@ -53,9 +52,10 @@ def measure(
     """Simulate the gear pair, pass the bearing forces through the case's measurement chain
     (housing modes, accelerometer, anti-alias filter, sampling, noise, ADC, tachometer) and write
     the record (case.simulation.record_time long) to OUT."""
+    import json
     from typing import get_args
 
-    from ._outputs import check_writable, resolve
+    from ._outputs import check_writable, claim_file, identity, resolve
 
     target = resolve(out, DEFAULT_OUT)
     out = target.path
@@ -86,10 +86,16 @@ def measure(
 
         case = without_faults(case)
     which = case.simulation.model
-    targets = [out] + ([out.with_suffix(".csv")] if csv else []) \
-        + ([out.with_suffix(".mat")] if mat else [])
-    refuse_overwrite(targets, force)
+    companions = tuple([out.with_suffix(".csv")] if csv else []) \
+        + tuple([out.with_suffix(".mat")] if mat else [])
     check_measurement(case)  # bad chain settings and sample rate fail before the simulation
+    ident = identity("measure", case, {"crack": crack, "csv": csv, "mat": mat})
+    if claim_file(target, ident, force=force, companions=companions):
+        err_console.print(f"[dim]{out} is up to date (same inputs); --force recomputes it[/dim]",
+                          highlight=False, soft_wrap=True)
+        console.print(f"  diagnose it: geardyn diagnose {out} --signal acc --tach tach",
+                      highlight=False, soft_wrap=True)
+        return
     with progress_bar() as bar:
         task = bar.add_task("stiffness map", total=None)
 
@@ -100,7 +106,7 @@ def measure(
         bar.update(task, description=f"model {which}", completed=0, total=None)
         result = run_measure(case, smap, model=which, cracked=crack, progress=tick)
     ds = result.record
-    write_netcdf(ds, out)
+    ds.attrs["geardyn_inputs"] = json.dumps(ident)
     written = [str(out)]
     if csv:
         write_csv(ds, out.with_suffix(".csv"))
@@ -108,6 +114,7 @@ def measure(
     if mat:
         write_mat(ds, out.with_suffix(".mat"))
         written.append(str(out.with_suffix(".mat")))
+    write_netcdf(ds, out)  # last: the NetCDF with its inputs marks the whole result done
     m = result.measured
     console.print(f"[green]done[/green]: {m.acc.size} samples at {m.fs:.6g} Hz "
                   f"({m.acc.size / m.fs:.4g} s), {m.pulse_times.size} tachometer pulses -> "

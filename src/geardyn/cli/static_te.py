@@ -15,10 +15,10 @@ from ._common import (
     SetOption,
     choice,
     console,
+    err_console,
     handle_errors,
     load_case_from_cli,
     progress_bar,
-    refuse_overwrite,
 )
 
 #: Default output file of ``geardyn static-te``.
@@ -40,8 +40,10 @@ def static_te(
     errors: Annotated[bool, typer.Option(
         "--errors/--no-errors", help="Include the case's [modifications] (tooth errors, relief, "
                                      "runout); --no-errors: perfect involutes.")] = True,
-    crack: Annotated[bool, typer.Option("--crack/--no-crack",
-                                        help="Use the cracked stiffness map.")] = False,
+    crack: Annotated[bool, typer.Option(
+        "--crack/--no-crack", help="Include the case's crack and faults (spall, breakage, "
+                                   "wear...): the faulty pair's map and gaps; --no-crack: the "
+                                   "healthy pair.")] = False,
     centre_distance_change: Annotated[str, typer.Option(
         "--centre-distance-change", "--dd", help="Centre distance change d' - d, a number in m "
                                                  "or a unit string such as '0.5 mm'.")] = "0",
@@ -56,11 +58,12 @@ def static_te(
     """Static transmission error of the pair, unloaded (T = 0) and loaded, along the line of
     action [um] and as pinion rotation [rad], over one hunting period: NetCDF with units to OUT
     and a figure beside it."""
+    import json
     import warnings
 
     from ..errors import InputError
     from ..units import to_si
-    from ._outputs import check_writable, resolve
+    from ._outputs import check_writable, claim_file, identity, resolve
 
     method = choice("--stiffness", stiffness, ("pem", "fe"))
     if not 16 <= points <= 1_000_000:
@@ -70,7 +73,6 @@ def static_te(
     # an unwritable --out (or one below a file, or a folder) fails here, not after the map
     check_writable(target, folder=False)
     png = out.with_suffix(".png")
-    refuse_overwrite([out, png], force)
     from .simulate import case_with_options
 
     # the stored case_toml is the case that was run (the option recorded as the value's source)
@@ -83,10 +85,27 @@ def static_te(
     from .geometry import operating_summary
 
     operating_summary(case.gear_pair(), dd)  # the teeth apart and in mesh, as geometry checks
-    has_crack = case.crack is not None and case.crack.active
-    if crack and not has_crack:
-        raise InputError("--crack", "the case has no enabled crack", "--no-crack, or a case "
-                         "with an enabled [crack]")
+    from ..faults import faults_from_case
+
+    faults = [f for f in faults_from_case(case) if not f.is_null()]
+    if crack and not faults:
+        raise InputError("--crack", "the case has no fault (no enabled [crack], no [[faults]] "
+                         "of non-zero size)", "--no-crack, or a case with a fault")
+    if not crack:  # the healthy pair: no faults at all (no wear gap either)
+        from ..faults import without_faults
+
+        case = without_faults(case)
+    ident = identity("static-te", case, {"crack": crack, "torque_N_m": tq, "errors": errors,
+                                         "centre_distance_change_m": dd, "points": points})
+    if claim_file(target, ident, force=force, companions=(png,)):
+        from ..io import read_netcdf
+
+        err_console.print(f"[dim]{out} is up to date (same inputs); --force recomputes it[/dim]",
+                          highlight=False, soft_wrap=True)
+        ds = read_netcdf(out)
+        _say(ds, out, png, points, case, crack, faults, bool(ds.attrs.get("tooth_errors", 0)),
+             verb="kept")
+        return
 
     from ..io import atomic_path, write_netcdf_atomic
     from ..modifications import ToothModifications
@@ -104,15 +123,35 @@ def static_te(
         smap = build_map(case, cracked=crack, progress=tick)
     ds = static_te_curves(case, tq, cracked=crack, errors=errors, stiffness_map=smap,
                           centre_distance_change=dd, n=points)
-    write_netcdf_atomic(ds, out)
+    ds.attrs["map_torque_N_m"] = float(case.motor.torque)
+    ds.attrs["tooth_errors"] = int(bool(errors and mods.active))
+    ds.attrs["geardyn_inputs"] = json.dumps(ident)
     fig = fig_static_te(ds)
-    with atomic_path(png, suffix=".png") as tmp:
+    with atomic_path(png, suffix=".png") as tmp:  # the figure first: the NetCDF marks it done
         fig.savefig(tmp, dpi=150, format="png")
+    write_netcdf_atomic(ds, out)
+    _say(ds, out, png, points, case, crack, faults, errors and mods.active)
+
+
+def _say(ds, out, png, points, case, crack, faults, errors_active, verb: str = "wrote"
+         ) -> None:
+    """The summary lines of a static-TE result (computed now or up to date)."""
     te = ds["transmission_error"].values
-    active = errors and mods.active
-    console.print(f"[green]wrote[/green] {out}, {png}: static TE over {points} pinion angles "
-                  f"({case.stiffness.method} map, {'cracked' if crack else 'healthy'}, "
-                  f"{'with the case' + chr(39) + 's tooth errors' if active else 'perfect teeth'})")
+    kinds = sorted({f.kind.replace("_", " ") for f in faults})
+    pair = (("faulty: " + ", ".join(kinds)) if crack else
+            "healthy" + (f" (the case's {', '.join(kinds)} left out; --crack includes it)"
+                         if faults else ""))
+    console.print(f"[green]{verb}[/green] {out}, {png}: static TE over {points} pinion angles "
+                  f"({case.stiffness.method} map, {pair}, "
+                  f"{'with the case' + chr(39) + 's tooth errors' if errors_active else 'perfect teeth'})",
+                  highlight=False, soft_wrap=True)
     for i, t in enumerate(ds["torque"].values):
         console.print(f"  T = {t:g} N m: mean {te[i].mean():.4g} um, peak-to-peak "
-                      f"{te[i].max() - te[i].min():.4g} um along the line of action")
+                      f"{te[i].max() - te[i].min():.4g} um along the line of action",
+                      highlight=False)
+    map_t = float(ds.attrs.get("map_torque_N_m", case.motor.torque))
+    if case.stiffness.method == "fe" and any(abs(float(t) - map_t) > 1e-9 * max(map_t, 1.0)
+                                             for t in ds["torque"].values if t > 0):
+        console.print(f"  note: the FE map's contact was solved at motor.torque = {map_t:g} N m "
+                      "and is used at the other torques as it is; for a map at another load: "
+                      "--set motor.torque=...", highlight=False, soft_wrap=True)
