@@ -69,7 +69,9 @@ def operating_summary(pair, dd: float) -> dict:
     option = "--centre-distance-change"
     shown = _Shown(f"{dd * 1e3:.6g} mm")
     lowest = pair.min_centre_distance_change()
-    if dd < lowest:
+    # within round-off of the zero-backlash centre distance (0 for a pair designed without
+    # backlash: a profile-shifted pair's computed -1e-17 m refused its own design) is zero
+    if dd < lowest - 1e-12 * pair.design_centre_distance:
         try:
             jn = pair.operating(dd, check=False).normal_backlash
             what = f"gives a normal backlash of {jn * 1e6:.2f} um"

@@ -6,6 +6,7 @@ keyed by a hash of everything they depend on.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 
 import numpy as np
@@ -135,11 +136,45 @@ def build_map(case, *, method: str | None = None, cracked: bool = True,
         # as stored (list attributes as JSON text), so a fresh map equals a cached one
         return StiffnessMap.from_dataset(m.to_dataset())
 
-    m, _ = cache.get_or_build("stiffness", key, ".nc", build,
-                              save=lambda obj, path: obj.to_dataset().to_netcdf(
-                                  path, engine="h5netcdf"),
-                              load=lambda path: load_cached_map(path, key))
+    from ..errors import GeometryError
+
+    try:
+        m, _ = cache.get_or_build("stiffness", key, ".nc", build,
+                                  save=lambda obj, path: obj.to_dataset().to_netcdf(
+                                      path, engine="h5netcdf"),
+                                  load=lambda path: load_cached_map(path, key))
+    except GeometryError as exc:
+        if exc.field != "centre_distance_change" or exc.value is None:
+            raise
+        raise _grid_error(case, dd, exc) from None
     return m
+
+
+def _grid_error(case, dd, exc):
+    """A map grid point the pair cannot run at (interference: a tip below the other gear's form
+    circle), named as the case's field with the change that would do (the check names the
+    model's own argument, ``centre_distance_change``)."""
+    from ..errors import GeometryError
+
+    bad = float(exc.value)
+    pair = case.gear_pair()
+
+    def interferes(d: float) -> bool:
+        return any(c.startswith("interference") for c in pair.checks(d))
+
+    hint = ""
+    if bad <= float(dd[0]) + 1e-15 and not interferes(float(dd[-1])):
+        lo, hi = bad, float(dd[-1])  # interferes at lo, not at hi
+        for _ in range(60):
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if interferes(mid) else (lo, mid)
+        up = math.ceil(hi * 1e5) / 1e5  # [m], rounded up to 0.01 mm
+        hint = (f"; this pair interferes below {hi * 1e3:.4f} mm: --set "
+                f"stiffness.centre_distance_min=\"{up * 1e3:g} mm\"")
+    field = ("stiffness.centre_distance_min" if bad <= float(dd[0]) + 1e-15
+             else "stiffness.centre_distance_max" if bad >= float(dd[-1]) - 1e-15
+             else "stiffness.centre_distance_min/max")
+    return GeometryError(field, f"{bad * 1e3:g} mm", f"{exc.allowed}{hint}")
 
 
 def load_cached_map(path, key: str) -> StiffnessMap:
