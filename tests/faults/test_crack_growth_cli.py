@@ -215,3 +215,16 @@ def test_fe_map_of_the_grown_path_through_the_cli(tmp_path):
     loss = ((kh[None, :] - k) / kh[None, :]).max(axis=1)
     assert 0 < loss[0] < loss[1], loss
     assert np.all(np.isfinite(ds["v_yg__FM4"].values))
+
+
+@pytest.mark.slow
+def test_a_growth_stopped_by_the_step_limit_says_it_is_not_a_life(tmp_path):
+    """QA walkthrough: 20 quick steps ended at 7.9 mm with "1.268e+08 cycles" and exit 0, read as
+    a life; --steps 0 wrote a result of zero cycles."""
+    r = _run(["--config", str(EXAMPLE), "--out", str(tmp_path / "z"), *PARIS, "--quick",
+              "--steps", "0"], tmp_path)
+    assert r.returncode == 2 and "--steps: got 0" in r.stderr, r.stderr
+    r = _run(["--config", str(EXAMPLE), "--out", str(tmp_path / "two"), *PARIS, "--quick",
+              "--steps", "2", "--points", "2", "--no-noise"], tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert "stopped at the step limit (2 steps" in r.stdout and "not a life" in r.stdout, r.stdout

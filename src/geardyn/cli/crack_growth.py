@@ -144,7 +144,8 @@ def crack_growth(
         show_default=False)] = None,
     step_size: Annotated[str | None, typer.Option(
         "--step-size", help="Crack extension per step, a length such as '1 mm' (default: "
-                            "module/6, --quick module/4).", show_default=False)] = None,
+                            "module/6, --quick module/4, at most 3.9 times the initial crack "
+                            "depth).", show_default=False)] = None,
     points: Annotated[int | None, typer.Option(
         "--points", help="Crack lengths simulated for the indicators (default 5, --quick 3).",
         show_default=False)] = None,
@@ -198,8 +199,8 @@ def crack_growth(
         raise InputError("--paris-m", paris_m, "a Paris exponent in (0, 20]")
     c_si = parse_paris_c(paris_c, paris_m)
     dk_th = parse_stress_intensity(paris_threshold, "--paris-threshold")
-    if steps is not None and not 0 <= steps <= 1000:
-        raise InputError("--steps", steps, "an integer from 0 to 1000")
+    if steps is not None and not 1 <= steps <= 1000:
+        raise InputError("--steps", steps, "an integer from 1 to 1000")
     if points is not None and not 1 <= points <= 100:
         raise InputError("--points", points, "an integer from 1 to 100")
     if snr is not None and (no_noise or not math.isfinite(snr)):
@@ -275,3 +276,10 @@ def crack_growth(
         f"{ds['K_I'].values[-1] / 1e6:.3g} MPa m^0.5; v_yg FM4 {fm4[0]:.3g} -> {fm4[-1]:.3g} "
         f"(healthy {float(ds['v_yg__FM4_healthy']) if 'v_yg__FM4_healthy' in ds else np.nan:.3g})"
         f" at {ok}/{ds.sizes['sample_length']} simulated lengths", soft_wrap=True)
+    if str(ds.attrs.get("stop", "")).startswith("n_steps"):
+        # not a life: the crack would grow on; the cycles are those to the last length
+        console.print(
+            f"[yellow]note[/yellow]: growth stopped at the step limit ({n_steps} steps of "
+            f"{step * 1e3:.3g} mm) at {a[-1] * 1e3:.3g} mm, before the tip reached the tooth's "
+            "outline: the cycles are those to this length, not a life. For the whole path: "
+            "raise --steps or --step-size.", soft_wrap=True, highlight=False)
