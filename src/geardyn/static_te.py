@@ -209,7 +209,8 @@ def static_te_curves(case, torque: float | None = None, *, cracked: bool = False
                      centre_distance_change: float = 0.0, n: int = 2048):
     """Unloaded and loaded static transmission error of a case in one Dataset.
 
-    :func:`static_te_of_case` at ``0`` and at ``torque`` (default the motor torque) [N m],
+    :func:`static_te_of_case` at ``0`` and at ``torque`` (default the motor torque) [N m]
+    (``0`` alone when ``torque`` is 0),
     stacked along a ``torque`` coordinate [N m], with the case's provenance in the attributes
     (what ``geardyn static-te`` writes). ``torque`` and ``centre_distance_change`` take numbers
     in SI units or strings with a unit, as :func:`static_te_of_case`.
@@ -233,14 +234,15 @@ def static_te_curves(case, torque: float | None = None, *, cracked: bool = False
 
         stiffness_map = build_map(case, cracked=cracked)
     t = float(case.motor.torque if torque is None else torque)
+    torques = [0.0, t] if t != 0.0 else [0.0]  # an unloaded request is the one curve
     parts = [static_te_of_case(case, tq, cracked=cracked, errors=errors,
                                stiffness_map=stiffness_map,
                                centre_distance_change=centre_distance_change, n=n)
-             for tq in (0.0, t)]
+             for tq in torques]
     ds = xr.concat(parts, dim="torque", data_vars="all", coords="minimal",
                    combine_attrs="drop_conflicts")
-    ds = ds.assign_coords(torque=("torque", [0.0, t], {"units": "N m",
-                                                        "long_name": "pinion torque"}))
+    ds = ds.assign_coords(torque=("torque", torques, {"units": "N m",
+                                                       "long_name": "pinion torque"}))
     ds.attrs.update({
         "title": "static transmission error, unloaded and loaded (rigid single-flank tester)",
         "case": case.name, "case_toml": case_to_toml(case),

@@ -452,7 +452,9 @@ def _raw_value(data: Mapping[str, Any], loc: tuple, default: Any) -> Any:
 
 def _allowed_keys(parent: str) -> list[str]:
     model: type[BaseModel] = Case
-    for p in [q for q in parent.split(".") if q]:
+    for p in [q for q in re.split(r"[.\[\]]", parent) if q]:
+        if p.isdigit():  # an entry of a list of tables (faults.0): its items' keys
+            continue
         f = model.model_fields.get(p)
         if f is None:
             return []

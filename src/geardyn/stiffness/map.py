@@ -624,11 +624,15 @@ class StiffnessMap:
                  "pairs_in_contact": ("1", "number of tooth pairs in contact"),
                  "transmission_error": ("rad", "static transmission error (pinion angle)"),
                  "load_share_exiting": ("1", "load sharing ratio of the pair past the end of "
-                                             "the theoretical path (extended contact, FE)")}
+                                             "the theoretical path (extended contact, FE)"),
+                 "fault_gap": ("m", "gap of the slot's worn flank along the line of action "
+                                    "(the material wear removed)")}
+        slots = self.extra["load_share"].shape[2] if "load_share" in self.extra else None
         for name, v in self.extra.items():
             dims = ("centre_distance_change", "node") + tuple(f"{name}_dim{k}"
                                                               for k in range(2, v.ndim))
-            if name == "load_share":
+            if name == "load_share" or (v.ndim == 3 and name == "fault_gap"
+                                        and slots in (None, v.shape[2])):
                 dims = ("centre_distance_change", "node", "slot")
             u, ln = units.get(name, ("", name))
             ds[name] = (dims, v, {"units": u, "long_name": ln})
