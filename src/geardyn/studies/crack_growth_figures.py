@@ -125,17 +125,19 @@ def _stiffness_label(ds) -> str:
 
 def fig_mesh_stiffness(ds):
     """The mesh stiffness of each sampled crack (PEM of the equivalent straight crack, or FE
-    of the grown path) and of the healthy pair [N/m] against pinion angle [deg], at the design
+    of the grown path) and of the healthy pair [N/um] against pinion angle [deg], at the design
     centre distance."""
     fig = _figure()
     ax = fig.subplots()
     th = np.degrees(ds["angle"].values)
-    ax.plot(th, ds["healthy_mesh_stiffness"].values, color="0.3", lw=0.9, label="healthy")
+    # in N/um (1e6 N/m): the axis's own "1e8" offset ran into the title
+    ax.plot(th, ds["healthy_mesh_stiffness"].values * 1e-6, color="0.3", lw=0.9,
+            label="healthy")
     for j, a in enumerate(ds["sample_length"].values):
-        ax.plot(th, ds["mesh_stiffness"].values[j], lw=0.9,
+        ax.plot(th, ds["mesh_stiffness"].values[j] * 1e-6, lw=0.9,
                 label=f"{a * 1e3:.3g} mm, N = {ds['sample_cycles'].values[j]:.3g}")
     ax.set_xlabel(r"pinion angle $\theta$ [deg]")
-    ax.set_ylabel(r"$k_{mb}$ [N/m]")
+    ax.set_ylabel(r"$k_{mb}$ [N/$\mu$m]")
     ax.set_title(f"Mesh stiffness per crack length ({_stiffness_label(ds)})")
     ax.legend(fontsize="x-small", loc="lower right")
     ax.grid(True, alpha=0.3)

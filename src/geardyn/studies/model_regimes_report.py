@@ -368,8 +368,14 @@ def figure_iterations(ds):
             if j == 0:
                 ax.set_ylabel("pinion speed [rad/s]")
             if iz == nz - 1:
-                fig.colorbar(mesh, ax=axes[:, j], location="bottom", shrink=0.8,
-                             aspect=30).set_label(label)
+                cb = fig.colorbar(mesh, ax=axes[:, j], location="bottom", shrink=0.8, aspect=30)
+                cb.set_label(label)
+                if isinstance(norm, LogNorm):  # decades only: minor labels ran into each other
+                    from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
+
+                    cb.ax.xaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0), numticks=8))
+                    cb.ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:.2g}"))
+                    cb.ax.xaxis.set_minor_formatter(NullFormatter())
     return fig
 
 
@@ -384,23 +390,27 @@ def figure_convergence(ds):
     fig, axes = plt.subplots(1, 2, figsize=(11, 3.9), layout="constrained")
     for j, s in enumerate(sigs):
         col = f"C{j}"
+        # markers shrink from signal to signal: two signals with the same values stay visible
+        ms = 7.5 - 1.5 * j
         ep = ds["convergence_error_predictor"].values[:-1, j]
         es = ds["convergence_error_start"].values[:, j]
-        axes[0].loglog(dt[:-1], ep, "o-", color=col, label=f"{_SIGNAL_LABELS.get(s, s)}, "
-                                                            "predictor")
-        axes[0].loglog(dt, es, "s--", color=col, label=f"{_SIGNAL_LABELS.get(s, s)}, start")
+        axes[0].loglog(dt[:-1], ep, "o-", color=col, ms=ms,
+                       label=f"{_SIGNAL_LABELS.get(s, s)}, predictor")
+        axes[0].loglog(dt, es, "s--", color=col, ms=ms,
+                       label=f"{_SIGNAL_LABELS.get(s, s)}, start")
         axes[1].loglog(dt, ds["convergence_rms_ii_minus_i_static"].values[:, j], "o-",
-                       color=col, label=_SIGNAL_LABELS.get(s, s))
+                       color=col, ms=ms, label=_SIGNAL_LABELS.get(s, s))
     axes[0].set_xlabel("time step dt [s]")
     axes[0].set_ylabel("RMS(II ref - II) / STD(II ref) [-]")
     axes[0].set_title("model II against the finest predictor run", fontsize=10)
-    axes[0].legend(fontsize=6.5, ncol=2)
     thr = float(ds.attrs.get("threshold", 0.1))
     axes[1].axhline(thr, color="red", lw=1.2)
     axes[1].set_xlabel("time step dt [s]")
     axes[1].set_ylabel("RMS(II - I-static) / STD(II) [-]")
     axes[1].set_title("model II vs I-static at each step", fontsize=10)
-    axes[1].legend(fontsize=7)
+    # one legend below both panels: inside, it covered the curves
+    handles, labels = axes[0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="outside lower center", ncol=4, fontsize=7)
     return fig
 
 

@@ -87,9 +87,11 @@ def plot_body_mesh(case, *, cracked: bool = True, zoom: bool = True,
         if crack is not None:
             c = 0.5 * (mesh.crack_mouth + mesh.crack_tip)
             r = 0.5 * crack.depth + 0.6 * m
-        else:
-            c = np.array([-0.1 * gear.tip_radius * math.pi / gear.teeth, gear.form_radius])
-            r = 0.6 * m
+        else:  # where the loaded (left) flank meets the fillet, at the form circle
+            rf = max(gear.form_radius, gear.base_radius)
+            half_angle = 0.5 * gear.thickness_at(rf) / rf
+            c = np.array([-rf * math.sin(half_angle), rf * math.cos(half_angle) - 0.3 * m])
+            r = 0.9 * m
         disp = None
         scale = 0.0
         if opening:
