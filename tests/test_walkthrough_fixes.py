@@ -43,3 +43,15 @@ def test_an_unloaded_static_te_is_one_curve():
     ds = static_te_curves(case, 0.0, n=64)
     assert list(ds["torque"].values) == [0.0]
     assert list(static_te_curves(case, 50.0, n=64)["torque"].values) == [0.0, 50.0]
+
+
+def test_config_validate_says_a_sweep_file_is_one():
+    """It said "base: unknown key" of the shipped sweep files."""
+    from typer.testing import CliRunner
+
+    from geardyn.cli import app
+
+    sweep = EXAMPLES / "sweep_spall_width.toml"
+    r = CliRunner().invoke(app, ["config", "validate", str(sweep)])
+    assert r.exit_code == 2
+    assert "a sweep file (it has [base], [axes]" in r.output and "geardyn sweep FILE" in r.output

@@ -72,7 +72,7 @@ def test_stiffness_without_a_crack(tmp_path):
 @pytest.mark.parametrize(("args", "words"), [
     (["--method", "magic"], "--method"),
     (["--set", "crack.depth=40mm"], "crack.depth"),
-    (["--set", "stiffness.centre_distance_max=6mm"], "centre_distance_change"),
+    (["--set", "stiffness.centre_distance_max=6mm"], "stiffness.centre_distance_max"),
 ])
 def test_bad_input_exits_2(tmp_path, args, words):
     r = _invoke(["stiffness", "--out", str(tmp_path / "o"), *SMALL, *args], tmp_path / "c")

@@ -50,7 +50,11 @@ def validate(file: Annotated[Path, typer.Argument(help="Case file (TOML) to chec
     from ..config import load_case_details, with_written_value
     from ..errors import InputError
 
-    details = load_case_details(file, set_ or [])
+    try:
+        details = load_case_details(file, set_ or [])
+    except InputError as exc:
+        _say_if_sweep_file(file, exc)
+        raise
     case = details.case
     try:
         notes = check_case(case)
@@ -65,6 +69,24 @@ def validate(file: Annotated[Path, typer.Argument(help="Case file (TOML) to chec
     for note in notes:
         console.print(f"[yellow]not checked[/yellow]: {escape(note)}", highlight=False,
                       soft_wrap=True)
+
+
+def _say_if_sweep_file(file, exc) -> None:
+    """A sweep file given to ``config validate`` is refused as a case with unknown keys
+    (``base``, ``axes``): say what it is and what checks it instead."""
+    import tomllib
+
+    from ..errors import InputError
+
+    try:
+        data = tomllib.loads(Path(file).read_text(encoding="utf-8"))
+    except (OSError, ValueError, UnicodeDecodeError):
+        return
+    if isinstance(data, dict) and ({"axes", "sample", "base", "execution"} & set(data)):
+        raise InputError(str(file), "a sweep file (it has " + ", ".join(
+            f"[{k}]" for k in ("base", "axes", "sample", "execution") if k in data) + ")",
+            "a case file: config validate checks cases; a sweep file is read, and refused with "
+            "its errors before any run, by 'geardyn sweep FILE'") from exc
 
 
 @config_app.command("schema")

@@ -171,9 +171,9 @@ def _grid_error(case, dd, exc):
         up = math.ceil(hi * 1e5) / 1e5  # [m], rounded up to 0.01 mm
         hint = (f"; this pair interferes below {hi * 1e3:.4f} mm: --set "
                 f"stiffness.centre_distance_min=\"{up * 1e3:g} mm\"")
-    field = ("stiffness.centre_distance_min" if bad <= float(dd[0]) + 1e-15
-             else "stiffness.centre_distance_max" if bad >= float(dd[-1]) - 1e-15
-             else "stiffness.centre_distance_min/max")
+    # closer centres interfere, farther ones lose the contact ratio: the end to move
+    field = ("stiffness.centre_distance_max" if "contact ratio" in str(exc.allowed)
+             else "stiffness.centre_distance_min")
     return GeometryError(field, f"{bad * 1e3:g} mm", f"{exc.allowed}{hint}")
 
 
