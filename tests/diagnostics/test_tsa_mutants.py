@@ -191,9 +191,12 @@ def test_unresolved_edge_warning_majority_rule_and_text():
     assert str(rec[0].message) == (
         "tach edges are not resolved by the sampling (2 of 3 rising edges jump from one level "
         "to the other between two samples): each pulse time is known only to +/- half a "
-        "sample, which lowers the TSA amplitude of an order at f cycles per sample by up to "
-        "1 - sinc(f) (0.8 % at 0.07 fs, 1.6 % at 0.1 fs). Record the tach through the "
-        "anti-alias filter, or give counter time stamps of the pulses.")
+        "sample, which lowers the TSA amplitude of an order at f cycles per sample by about "
+        "1 - sinc(f) (0.8 % at 0.07 fs, 1.6 % at 0.1 fs) when the pulses fall anywhere within "
+        "the sample intervals, and by more when the speed is locked to the sample rate (a "
+        "whole number of samples per pulse repeats the same error in every revolution). "
+        "Record the tach through the anti-alias filter, or give counter time stamps of the "
+        "pulses.")
     # 1 of 2 (not more than half): silent
     with warnings.catch_warnings():
         warnings.simplefilter("error")
