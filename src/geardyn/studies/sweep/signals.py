@@ -177,7 +177,8 @@ def short_record_error(exc, ds, case) -> DataFileError:
     ``geardyn diagnose`` gives for a short simulation file, from the same function)."""
     import numpy as np
 
-    from ...diagnostics.pipeline import Measurement, _short_record
+    from ...diagnostics.loading import Measurement
+    from ...diagnostics.pipeline import _short_record
 
     t = np.asarray(ds["time"].values, dtype=np.float64)
     m = Measurement(signals={"theta_p": np.asarray(ds["theta_p"].values)}, time=t)
