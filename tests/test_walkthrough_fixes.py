@@ -55,3 +55,18 @@ def test_config_validate_says_a_sweep_file_is_one():
     r = CliRunner().invoke(app, ["config", "validate", str(sweep)])
     assert r.exit_code == 2
     assert "a sweep file (it has [base], [axes]" in r.output and "geardyn sweep FILE" in r.output
+
+
+def test_config_show_says_what_validate_would_refuse(tmp_path):
+    """It showed a crack deeper than the tooth without a word (exit 0) where validate refuses."""
+    import os
+
+    from ._cli_fork import run_geardyn
+
+    env = {**os.environ, "GEARDYN_CACHE_DIR": str(tmp_path / "cache")}
+    r = run_geardyn(["config", "show", "--set", "crack.depth=20 mm"], capture_output=True,
+                    text=True, env=env, timeout=120)
+    assert r.returncode == 0 and "[crack.depth]" in r.stdout, r.stderr
+    assert "does not pass 'geardyn config validate': crack.depth: got '20 mm" in r.stderr
+    r = run_geardyn(["config", "show"], capture_output=True, text=True, env=env, timeout=120)
+    assert r.returncode == 0 and "does not pass" not in r.stderr

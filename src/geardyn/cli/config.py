@@ -6,9 +6,10 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
+from rich.markup import escape
 
 from . import app
-from ._common import ConfigOption, SetOption, console, handle_errors
+from ._common import ConfigOption, SetOption, console, err_console, handle_errors
 
 config_app = typer.Typer(help="Show, validate and describe case files.", no_args_is_help=True)
 app.add_typer(config_app, name="config")
@@ -18,11 +19,21 @@ app.add_typer(config_app, name="config")
 @handle_errors
 def show(config: ConfigOption = None, set_: SetOption = None) -> None:
     """Print the effective case as TOML: each value as written (e.g. "20 deg") with its SI value
-    beside when it differs, its source and its origin (case file, --set or default)."""
-    from ..config import case_to_display_toml, load_case_details
+    beside when it differs, its source and its origin (case file, --set or default). A case that
+    'config validate' would refuse is shown all the same, with the reason on standard error."""
+    from ..case_checks import check_case
+    from ..config import case_to_display_toml, load_case_details, with_written_value
+    from ..errors import InputError
+    from ._common import one_line
 
     details = load_case_details(config, set_ or [])
     typer.echo(case_to_display_toml(details), nl=False)
+    try:  # shown to be read, not run: say what the commands that run it would refuse
+        check_case(details.case)
+    except InputError as exc:
+        err_console.print(f"[yellow]note[/yellow]: this case does not pass 'geardyn config "
+                          f"validate': {escape(one_line(str(with_written_value(exc, details))))}",
+                          highlight=False, soft_wrap=True)
 
 
 @config_app.command("validate")
@@ -44,7 +55,6 @@ def validate(file: Annotated[Path, typer.Argument(help="Case file (TOML) to chec
     them: the time-step limit from the map's largest mesh stiffness (the step is still checked
     against the mesh frequency and the natural frequencies without mesh stiffness), the mesh
     stiffness at the static operating point, the tooth modifications and the kernel set-up."""
-    from rich.markup import escape
 
     from ..case_checks import check_case
     from ..config import load_case_details, with_written_value
