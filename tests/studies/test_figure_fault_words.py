@@ -73,3 +73,19 @@ def test_fig6_names_a_map_with_other_faults_faulty():
     assert any(t.startswith("Healthy and faulty mesh stiffness") for t in texts), texts
     assert not any("(cracked" in t for t in texts)
     assert any("(cracked" in t for t in _texts(fig_crack(healthy, cracked, n=200)))
+
+
+def test_fig6_says_a_crack_on_the_gear_is_on_the_gear():
+    """Its axis runs past 360 deg of pinion angle when the crack passes near 360 deg; nothing
+    said the crack was on the gear (QA walkthrough)."""
+    from .test_report_own_case import SPALL
+
+    gear_crack = SPALL.with_name("root_crack_gear.toml")
+    over = ['stiffness.method="pem"', "stiffness.centre_distances=4",
+            "stiffness.nodes_per_segment=8"]
+    case = load_case(gear_crack, over)
+    healthy, cracked = build_map(case, cracked=False), build_map(case, cracked=True)
+    assert "fault on the gear" in _texts(fig_crack(healthy, cracked, n=200))[0]
+    pinion = geardyn.paper_case(over)
+    assert "gear)" not in _texts(fig_crack(build_map(pinion, cracked=False),
+                                           build_map(pinion, cracked=True), n=200))[0]

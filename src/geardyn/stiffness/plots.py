@@ -166,6 +166,22 @@ def fig_load_sharing(m: StiffnessMap, dds: Sequence[float] = DEFAULT_DD, *,
     return fig
 
 
+
+def _on_gear(m: StiffnessMap) -> bool:
+    """Whether the map's crack or faults are all on the gear (its ``parameters`` attribute)."""
+    p = m.attrs.get("parameters")
+    if isinstance(p, str):
+        try:
+            p = json.loads(p)
+        except ValueError:
+            return False
+    if not isinstance(p, dict):
+        return False
+    gears = [f.get("gear") for f in p.get("faults") or [] if isinstance(f, dict)]
+    if isinstance(p.get("crack"), dict):
+        gears.append(p["crack"].get("gear"))
+    return bool(gears) and all(g == "gear" for g in gears)
+
 def fig_crack(healthy: StiffnessMap, cracked: StiffnessMap,
               dds: Sequence[float] = (0.0, 1.0e-3), *, theta_center: float | None = None,
               n: int = 2000, faulty: str = "cracked") -> Figure:
@@ -205,7 +221,9 @@ def fig_crack(healthy: StiffnessMap, cracked: StiffnessMap,
                 label=f"{name} ({faulty}, $\\Delta d$ = {d * 1e3:g} mm{extra})")
     ax.set_xlabel(r"pinion rolling angle $\theta$ [deg]")
     ax.set_ylabel(r"combined torsional mesh stiffness $K_t$ [N m/rad]")
-    ax.set_title(f"Healthy and {faulty} mesh stiffness ({cracked.attrs.get('method', '?')})")
+    where = ", fault on the gear" if _on_gear(cracked) else ""
+    ax.set_title(f"Healthy and {faulty} mesh stiffness ({cracked.attrs.get('method', '?')}"
+                 f"{where})")
     ax.grid(True, alpha=0.3)
     _legend_below(fig, ax, ncols=2)
     return fig
