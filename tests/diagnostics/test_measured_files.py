@@ -263,3 +263,18 @@ def test_cli_names_with_brackets_speed_and_tach_options(tmp_path):
                      "--angle", "time [s]", "--tach-edge", "falling", "-o", str(tmp_path / "x")],
                     capture_output=True, text=True, env=env, timeout=300)
     assert r.returncode == 2 and "--tach-edge" in r.stderr and "Traceback" not in r.stderr
+
+
+def test_decimal_commas_after_whole_number_rows_and_commas_in_names(tmp_path):
+    """Mutation pass: decimal commas were looked for in the first five data rows only (a
+    recorder's pre-trigger zeros hid them), and the header's commas became points."""
+    from geardyn.diagnostics.io import read_table
+
+    path = tmp_path / "late.csv"
+    path.write_text("Zeit [s];Beschl. [g]\n" + "0;0\n" * 5 + "0,00005;0,125\n0,0001;-0,25\n")
+    t = read_table(path)
+    assert list(t.columns["Beschl. [g]"]) == [0.0] * 5 + [0.125, -0.25]
+    path.write_text("Zeit [s];Kraft, axial [N]\n0,0;1,5\n0,1;2,5\n")
+    t = read_table(path)
+    assert t.names == ["Zeit [s]", "Kraft, axial [N]"]
+    assert list(t.columns["Kraft, axial [N]"]) == [1.5, 2.5]

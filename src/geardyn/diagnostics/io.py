@@ -180,21 +180,27 @@ def _read_text(p: Path) -> DataTable:
     first = body[0][1]
     # ';' first: a European spreadsheet writes ';' between fields and ',' in numbers
     delim = ";" if ";" in first else "," if "," in first else "\t" if "\t" in first else None
-    decimal_comma = delim == ";" and any("," in ln and "." not in ln for _, ln in body[1:6])
 
-    def split(line: str) -> list[str]:
-        toks = [t.strip() for t in (line.split(delim) if delim else line.split())]
-        return [t.replace(",", ".") for t in toks] if decimal_comma else toks
+    def fields(line: str) -> list[str]:
+        return [t.strip() for t in (line.split(delim) if delim else line.split())]
 
-    head = split(first)
+    head = fields(first)
     header = None
-    try:
-        [float(t) for t in head]
-    except ValueError:
+    try:  # (with ';' between fields a first row of numbers may have decimal commas)
+        [float(t.replace(",", ".") if delim == ";" else t) for t in head]
+    except ValueError:  # the column names, as written (a comma in a name stays)
         header = [h.strip('"').strip("'") or str(i) for i, h in enumerate(head)]
         body = body[1:]
     if not body:
         raise DataFileError(p, "a header but no data rows")
+    # a comma in any data line of a ';'-separated file is a decimal comma (a recorder's
+    # pre-trigger rows may be whole numbers: not only the first rows tell)
+    decimal_comma = delim == ";" and any("," in ln for _, ln in body)
+
+    def split(line: str) -> list[str]:
+        toks = fields(line)
+        return [t.replace(",", ".") for t in toks] if decimal_comma else toks
+
     ncol = len(head)
     data = None
     # fast path (C parser); the line loop below gives precise messages and NaN fields
@@ -292,7 +298,8 @@ def _units_comment(lines: list[str], names: list[str]) -> dict[str, str]:
         for item in m.group(1).split(","):
             item = item.strip()
             unit = unit_in_name(item)
-            name = item[:item.rfind("[")].strip() if "[" in item else ""
+            cut = max(item.rfind("["), item.rfind("("))  # "acc [g]" or "force (N)"
+            name = item[:cut].strip() if cut > 0 else ""
             if unit and name in names:
                 out[name] = unit
         return out
