@@ -186,3 +186,34 @@ def test_ctrl_c_to_the_group_while_a_second_process_builds_fe_bodies(tmp_path):
         time.sleep(0.1)
     assert not [k for k in kids if _running(k)], [_cmdline(k) for k in kids if _running(k)]
     assert not list(target.glob("*.nc")) if target.exists() else True
+
+
+def test_a_half_built_llvm_object_after_ctrl_c_prints_nothing():
+    """CI, 2026-11-26: a Ctrl-C while numba compiled the kernel (a fresh numba cache) cut an
+    llvmlite object's construction short; its ``__del__`` then raised ``AttributeError:
+    'PassBuilder' object has no attribute '_as_parameter_'``, which Python printed with a
+    traceback after geardyn's "interrupted" line. The CLI's unraisable hook drops exactly that;
+    anything else still reaches the default hook."""
+    from types import SimpleNamespace
+
+    from geardyn.cli._common import _unraisable
+
+    seen = []
+    hook = _unraisable(seen.append)
+
+    def llvm_del():  # stands for llvmlite.binding.ffi._ObjectRef.__del__
+        pass
+
+    llvm_del.__module__ = "llvmlite.binding.ffi"
+    half_built = SimpleNamespace(
+        exc_value=AttributeError("'PassBuilder' object has no attribute '_as_parameter_'"),
+        object=llvm_del)
+    hook(half_built)
+    assert seen == []
+    other = SimpleNamespace(exc_value=AttributeError("'X' object has no attribute 'y'"),
+                            object=llvm_del)
+    ours = SimpleNamespace(exc_value=AttributeError("no attribute '_as_parameter_'"),
+                           object=test_a_half_built_llvm_object_after_ctrl_c_prints_nothing)
+    hook(other)
+    hook(ours)
+    assert seen == [other, ours]

@@ -102,9 +102,21 @@ def _unraisable(default):
         if isinstance(args.exc_value, KeyboardInterrupt):
             _INTERRUPT["pending"] = True
             return
+        if _half_built_llvm_object(args):
+            return
         default(args)
 
     return hook
+
+
+def _half_built_llvm_object(args) -> bool:
+    """Whether an unraisable exception is llvmlite's ``__del__`` of an object whose
+    construction a Ctrl-C cut short (numba compiling): ``AttributeError: ... no attribute
+    '_as_parameter_'``, printed with a traceback while the process ends after the interrupt."""
+    obj = getattr(args, "object", None)
+    return (isinstance(args.exc_value, AttributeError)
+            and "_as_parameter_" in str(args.exc_value)
+            and str(getattr(obj, "__module__", "") or "").startswith("llvmlite"))
 
 
 def raise_pending_interrupt() -> None:
@@ -168,7 +180,10 @@ def handle_errors(fn: F) -> F:
         finally:
             if old is not None:
                 signal.signal(signal.SIGINT, old)
-                sys.unraisablehook = old_hook
+                # after an interrupt the half-built llvmlite objects are collected as the
+                # process ends: the hook that keeps their __del__ quiet stays
+                if not _INTERRUPT["pending"]:
+                    sys.unraisablehook = old_hook
             _INTERRUPT["pending"] = False
 
     return wrapper  # type: ignore[return-value]
