@@ -89,15 +89,20 @@ def crack_angle(healthy: StiffnessMap, cracked: StiffnessMap, dd: float = 0.0,
     return float(th[int(np.argmin(ratio))])
 
 
-def _crack_depth(m: StiffnessMap) -> float | None:
+def _parameters(m: StiffnessMap) -> dict:
+    """The map's ``parameters`` attribute as a dict (stored as JSON text), or {}."""
     p = m.attrs.get("parameters")
     if isinstance(p, str):
         try:
             p = json.loads(p)
         except ValueError:
-            return None
+            return {}
+    return p if isinstance(p, dict) else {}
+
+
+def _crack_depth(m: StiffnessMap) -> float | None:
     try:
-        return float(p["crack"]["depth_m"])
+        return float(_parameters(m)["crack"]["depth_m"])
     except (TypeError, KeyError, ValueError):
         return None
 
@@ -169,14 +174,7 @@ def fig_load_sharing(m: StiffnessMap, dds: Sequence[float] = DEFAULT_DD, *,
 
 def _on_gear(m: StiffnessMap) -> bool:
     """Whether the map's crack or faults are all on the gear (its ``parameters`` attribute)."""
-    p = m.attrs.get("parameters")
-    if isinstance(p, str):
-        try:
-            p = json.loads(p)
-        except ValueError:
-            return False
-    if not isinstance(p, dict):
-        return False
+    p = _parameters(m)
     gears = [f.get("gear") for f in p.get("faults") or [] if isinstance(f, dict)]
     if isinstance(p.get("crack"), dict):
         gears.append(p["crack"].get("gear"))
