@@ -108,7 +108,7 @@ def check_case(case, *, cache=None) -> list[str]:
             raise InputError("crack.tooth", crack.tooth,
                              f"a tooth number in [0, {z - 1}] of the {crack.gear}")
     if case.stiffness.method == "pem":
-        _check_pem(case, dd, ends)
+        _check_pem(case, dd)
     else:
         _check_fe(case, pair, crack)
 
@@ -156,17 +156,17 @@ def check_measurement(case):
     return chain
 
 
-def _check_pem(case, dd, ends) -> None:
+def _check_pem(case, dd) -> None:
     from .errors import GeometryError
     from .stiffness.pem import PEMModel
 
     pem = PEMModel.from_case(case, cracked=True)  # builds the cracked section: crack geometry
     try:
         pem.check_range(dd)
-    except GeometryError as exc:
-        field = ends[0][0] if exc.value is not None and float(exc.value) <= ends[0][1] \
-            else ends[1][0]
-        raise _relabel(exc, field) from None
+    except GeometryError as exc:  # named as the map builder names it, with the start that works
+        from .stiffness import _grid_error
+
+        raise _grid_error(case, dd, exc) from None
 
 
 def _check_fe(case, pair, crack) -> None:

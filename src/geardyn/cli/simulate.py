@@ -39,21 +39,21 @@ def case_with_options(case, options: dict[str, tuple[str, object]]):
 
 
 def _recorded_identity(path: Path) -> tuple[dict | None, int | None]:
-    """The inputs identity and ``complete`` flag a geardyn record carries (None if not one)."""
-    import json
-
+    """The inputs identity (:func:`._outputs.recorded_inputs`) and ``complete`` flag a geardyn
+    record carries (None if not one)."""
     import h5py
     import numpy as np
 
+    from ._outputs import recorded_inputs
+
+    ident = recorded_inputs(path)
+    if ident is None:
+        return None, None
     try:
         with h5py.File(path, "r") as f:
-            text = f.attrs.get("geardyn_inputs")
-            complete = f.attrs.get("complete")
-        text = text.decode() if isinstance(text, bytes) else text
-        ident = json.loads(text) if text else None
-        flag = np.asarray(complete).ravel()
-        return (ident if isinstance(ident, dict) else None), (int(flag[0]) if flag.size else None)
-    except (OSError, ValueError, TypeError):
+            flag = np.asarray(f.attrs.get("complete")).ravel()
+        return ident, (int(flag[0]) if flag.size else None)
+    except (OSError, ValueError, TypeError):  # (no flag at all: int(None))
         return None, None
 
 

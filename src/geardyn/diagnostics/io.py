@@ -241,11 +241,9 @@ def _comment_entries(lines: list[str]) -> tuple[dict[str, float], dict[str, str]
             scalars[key] = float(value)
         except ValueError:
             if is_rate_key(key):  # "# fs = 20 kHz", "# sample_rate = 51200 Hz"
-                try:
+                with contextlib.suppress(ValueError):  # not a frequency: kept as text
                     scalars[key] = parse_frequency(value, key)
                     continue
-                except ValueError:
-                    pass
             text[key] = value
     return scalars, text
 

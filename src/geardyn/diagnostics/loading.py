@@ -17,10 +17,8 @@ import numpy as np
 from geardyn.errors import DataFileError, InputError
 
 from .io import NETCDF_SUFFIXES, read_simulation, read_table, stored_rate, unit_in_name
-from .tsa import (
-    _check_int,
-    tach_pulse_times,
-)
+from .tsa import _check_int, tach_pulse_times
+from .tsa import tach_threshold as tach_threshold_level
 
 __all__ = ["SIMULATION_SIGNALS", "Measurement", "load_simulation", "load_measurement", "load"]
 
@@ -318,7 +316,8 @@ def load_measurement(
                                       min_interval=tach_min_interval, name_of=name_of)
         if tach_times.size < 2:
             level = ("" if tach_column_is_pulse_times else
-                     f" at the threshold {_threshold(col, tach_threshold):.6g} (the tach's "
+                     f" at the threshold {tach_threshold_level(col, tach_threshold):.6g} (the "
+                     f"tach's "
                      f"{'mid-range' if tach_threshold is None else 'given level'}; a spike "
                      f"lifts the mid-range: set {name_of('tach_threshold')})")
             raise InputError(name_of("tach"), tach, "a tachometer channel with at least 2 "
@@ -339,11 +338,6 @@ def load_measurement(
                               for k in signals},
                        source=str(path))
 
-
-
-def _threshold(col: np.ndarray, given: float | None) -> float:
-    """The tach's edge level: ``given``, else mid-range (as :func:`tach_pulse_times`)."""
-    return float(given) if given is not None else 0.5 * (float(np.min(col)) + float(np.max(col)))
 
 
 def _pulse_times(col, *, fs, time, threshold, edge, min_interval, name_of) -> np.ndarray:
@@ -377,7 +371,8 @@ def _pulse_times(col, *, fs, time, threshold, edge, min_interval, name_of) -> np
                 name_of("tach"), f"{times.size} pulses, {short} too soon",
                 f"a pulse train with one edge per pulse ({short} pulses came less than half "
                 "their neighbours' interval after the one before: noise on a slow edge, or a "
-                f"second edge, crosses the threshold {_threshold(col, threshold):.6g} again); "
+                "second edge, crosses the threshold "
+                f"{tach_threshold_level(col, threshold):.6g} again); "
                 f"set {name_of('tach_min_interval')} (e.g. {0.5 * med:.3g} s, half the "
                 f"regular interval), {name_of('tach_threshold')} or {name_of('tach_edge')}")
     return times

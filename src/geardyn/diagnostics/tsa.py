@@ -65,6 +65,7 @@ __all__ = [
     "TSAResult",
     "tsa",
     "tach_pulse_times",
+    "tach_threshold",
     "angle_from_tach",
 ]
 
@@ -344,6 +345,15 @@ def _check_angle(angle: np.ndarray, name: str, unwrap: bool
 # --------------------------------------------------------------------------------------------
 # tachometer
 # --------------------------------------------------------------------------------------------
+def tach_threshold(signal, threshold: float | None = None) -> float:
+    """The edge level of a tachometer pulse train: ``threshold``, else midway between the
+    signal's minimum and maximum (unit of the signal)."""
+    if threshold is not None:
+        return float(threshold)
+    s = np.asarray(signal, dtype=np.float64)
+    return 0.5 * (float(s.min()) + float(s.max()))
+
+
 def tach_pulse_times(signal, *, fs: float | None = None, time=None,
                      threshold: float | None = None,
                      min_interval: float | None = None, edge: str = "rising") -> np.ndarray:
@@ -398,7 +408,7 @@ def tach_pulse_times(signal, *, fs: float | None = None, time=None,
     if edge not in ("rising", "falling"):
         raise InputError("edge", edge, "'rising' or 'falling'")
     t = _sample_times(s.shape[0], fs, time)
-    c = 0.5 * (s.min() + s.max()) if threshold is None else float(threshold)
+    c = tach_threshold(s, threshold)
     if not s.min() < c <= s.max():
         raise InputError("threshold", c, f"a level between the tach minimum {s.min():.6g} and "
                          f"maximum {s.max():.6g}")
