@@ -14,6 +14,48 @@ os.environ.setdefault("MPLBACKEND", "Agg")
 os.environ.setdefault("GEARDYN_FE_PROCESSES", "0")
 
 
+def _typer_shape(app) -> tuple:
+    """What typer's ``get_command`` reads of a Typer app: its callback, its commands (with their
+    callbacks) and its sub-apps, recursively (object identities: a command or sub-app added,
+    removed or replaced is another shape)."""
+    return (id(app.registered_callback), id(app.info.callback),
+            tuple((id(c), id(c.callback)) for c in app.registered_commands),
+            tuple((id(g), _typer_shape(g.typer_instance)) for g in app.registered_groups
+                  if g.typer_instance is not None))
+
+
+def _memoise_typer_get_command() -> None:
+    """typer's ``CliRunner.invoke`` converts the Typer app into its click command tree on every
+    call: 25-45 ms of each in-process CLI run (cProfile, 2026-11-26: 5.5 s of the 14 s of 120
+    fuzzed ``simulate``/``stiffness`` runs), a few thousand times in the suite. The conversion
+    depends only on the app's shape (see :func:`_typer_shape`), so the tests reuse the click tree
+    of an app of unchanged shape. Each invocation still creates its own click context, parses
+    its own arguments and runs the command's function; nothing in geardyn or typer changes a
+    command tree while running a command (``geardyn.cli.main``'s ``_tidy_help`` runs on the tree
+    it builds itself, never on this one)."""
+    import typer.testing
+
+    build = typer.testing._get_command
+    if getattr(build, "_geardyn_memo", False):
+        return
+    built: dict[int, tuple] = {}
+
+    def get_command(app):
+        shape = _typer_shape(app)
+        hit = built.get(id(app))
+        if hit is not None and hit[0] is app and hit[1] == shape:
+            return hit[2]
+        command = build(app)
+        built[id(app)] = (app, shape, command)
+        return command
+
+    get_command._geardyn_memo = True
+    typer.testing._get_command = get_command
+
+
+_memoise_typer_get_command()
+
+
 def pytest_configure(config):
     """pytest-xdist controller: one cache folder for the whole session, shared by the workers
     (the cache's entry locks make concurrent builders safe, so a body or map that tests on both
@@ -46,41 +88,48 @@ def pytest_collection_modifyitems(config, items):
     """The files with the longest tests first (longest-processing-time-first scheduling: the
     two workers then finish together instead of one running the last long file alone); other
     files keep their order. The weights are the files' test time in seconds, measured with
-    ``python3 -m pytest --durations=120`` on the 2-core machine on 2026-11-26 (a file's place
-    in the queue is all they decide: a stale weight costs time, never a result)."""
+    ``python3 -m pytest --durations=0`` on the 2-core machine (see :data:`LONGEST_FILES`; a
+    file's place in the queue is all they decide: a stale weight costs time, never a result)."""
     order = {path: -weight for path, weight in LONGEST_FILES.items()}
     items.sort(key=lambda it: order.get(it.nodeid.split("::", 1)[0], 0.0))
 
 
-#: Test files over 10 s, by their measured test time [s] (see pytest_collection_modifyitems;
-#: 2026-11-26, the four sweep, crack-growth and direct-contact files after this morning's
-#: changes to them).
+#: Test files over 5 s, by their measured test time [s] (setup + call + teardown, summed from
+#: ``python3 -m pytest -p no:cacheprovider --durations=0`` on 2026-11-26, after the in-process
+#: CLI runs stopped rebuilding typer's click tree, see :func:`_memoise_typer_get_command`;
+#: measured while another job loaded the machine, so about 1.3x the quiet figures: only their
+#: order matters). The files not listed take under 5 s each and fill the end of the queue.
 LONGEST_FILES = {
-    "tests/hardening/test_fuzz_commands.py": 56.5,
-    "tests/faults/test_examples.py": 55.9,
-    "tests/sweep/test_kill_resume.py": 29.0,
-    "tests/studies/test_paper_run.py": 46.0,
-    "tests/sweep/test_dask_cluster.py": 18.0,
-    "tests/fe/test_load_consistent.py": 13.6,
-    "tests/reliability/test_kill.py": 41.3,
-    "tests/fe/test_background_bodies.py": 39.4,
-    "tests/cli/test_reruns.py": 39.1,
-    "tests/faults/test_crack_growth_cli.py": 20.3,
-    "tests/hardening/test_interrupts.py": 24.5,
-    "tests/faults/test_fault_sweeps.py": 23.6,
-    "tests/hardening/test_fuzz_config.py": 17.4,
-    "tests/faults/test_sif.py": 16.8,
-    "tests/cli/test_cli_foundation.py": 16.3,
-    "tests/studies/test_warm_run_cache.py": 15.7,
-    "tests/fe/test_fe_faults.py": 13.7,
-    "tests/dynamics/test_transverse_examples.py": 12.8,
-    "tests/test_readme.py": 11.2,
-    "tests/cli/test_cli_polish.py": 10.8,
-    "tests/hardening/test_cache_and_files.py": 10.4,
-    "tests/cli/test_simulate_cli.py": 10.1,
-    # added in the afternoon's QA fixes (their test time under load / 1.25)
-    "tests/cli/test_diagnose_pulses.py": 16.0,
-    "tests/cli/test_diagnose_inputs.py": 13.0,
+    "tests/faults/test_examples.py": 63.6,
+    "tests/hardening/test_fuzz_commands.py": 51.6,
+    "tests/studies/test_paper_run.py": 45.5,
+    "tests/fe/test_background_bodies.py": 40.4,
+    "tests/reliability/test_kill.py": 34.6,
+    "tests/sweep/test_kill_resume.py": 26.8,
+    "tests/cli/test_reruns.py": 24.6,
+    "tests/faults/test_sif.py": 24.0,
+    "tests/hardening/test_interrupts.py": 21.9,
+    "tests/faults/test_fault_sweeps.py": 20.6,
+    "tests/faults/test_crack_growth_cli.py": 19.6,
+    "tests/config/test_validate_completeness.py": 19.4,
+    "tests/sweep/test_dask_cluster.py": 16.6,
+    "tests/cli/test_diagnose_pulses.py": 15.0,
+    "tests/sweep/test_example.py": 14.2,
+    "tests/cli/test_cli_foundation.py": 13.8,
+    "tests/fe/test_fe_faults.py": 13.3,
+    "tests/test_readme.py": 13.2,
+    "tests/fe/test_load_consistent.py": 13.2,
+    "tests/studies/test_warm_run_cache.py": 11.9,
+    "tests/cli/test_cli_polish.py": 11.2,
+    "tests/sweep/test_failed_runs_exit.py": 11.1,
+    "tests/dynamics/test_kernel_mutants.py": 10.7,
+    "tests/fe/test_contact.py": 10.0,
+    "tests/studies/test_model_regimes.py": 9.4,
+    "tests/dynamics/test_transverse_examples.py": 8.4,
+    "tests/fe/test_crack_path_map.py": 7.6,
+    "tests/cli/test_diagnose_inputs.py": 7.6,
+    "tests/cli/test_file_reruns.py": 6.4,
+    "tests/fe/test_stiffness_fe.py": 5.2,
 }
 
 

@@ -54,6 +54,17 @@ FRICTION = textwrap.dedent("""
 """)
 
 
+@pytest.fixture(autouse=True)
+def _close_the_scripts_figures():
+    """The example script's ``main`` draws with pyplot and returns its figure (the tests look at
+    it): closed after each test, so that no figure outlives it in the worker
+    (tests/diagnostics/test_plots.py::test_no_pyplot_state checks that geardyn's own plots leave
+    none, whichever file the worker ran before)."""
+    yield
+    if "matplotlib.pyplot" in sys.modules:
+        sys.modules["matplotlib.pyplot"].close("all")
+
+
 @pytest.mark.slow
 def test_plot_sweep_example(tmp_path, client):
     store = tmp_path / "small.zarr"
