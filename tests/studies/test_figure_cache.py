@@ -55,3 +55,33 @@ def test_without_cache_or_fingerprint_the_figure_is_drawn(tmp_path, monkeypatch)
     s.cached("f", draw, y, extra=object())             # cannot be fingerprinted: drawn, not cached
     assert CALLS == ["t", "t", "t"] and isinstance(s["f"], RenderedFigure)
     assert not (tmp_path / "cache" / "figure").exists()
+
+
+def test_a_constrained_layout_figure_is_saved_without_a_second_tight_drawing():
+    """png_bbox: a figure with a layout engine (every report figure) fits its canvas already, so
+    it is saved as it is; one without is cropped to its content. The constrained figure's PNG
+    is the canvas at FIGURE_DPI, its labels inside it."""
+    import io
+
+    from matplotlib.figure import Figure
+    from PIL import Image
+
+    from geardyn.studies.paper_result import FIGURE_DPI
+    from geardyn.studies.report import png_bbox
+
+    fig = Figure(figsize=(3.0, 2.0), layout="constrained")
+    ax = fig.subplots()
+    ax.plot([0.0, 1.0], [0.0, 1e6])
+    ax.set_xlabel("a long label on the x axis [m]")
+    ax.set_ylabel("y [N]")
+    assert png_bbox(fig) is None
+    assert png_bbox(Figure(figsize=(3.0, 2.0))) == "tight"
+    assert png_bbox(RenderedFigure(b"")) == "tight"
+    s = FigureStore()
+    s["f"] = fig
+    img = np.asarray(Image.open(io.BytesIO(s["f"].png)).convert("L"))
+    assert img.shape == (2.0 * FIGURE_DPI, 3.0 * FIGURE_DPI)
+    # nothing drawn on the outermost pixel rows and columns: the layout kept the labels inside
+    assert img[[0, -1], :].min() == 255 and img[:, [0, -1]].min() == 255
+    # ... and the labels are there: dark pixels near the bottom edge (the x label)
+    assert img[-int(0.15 * FIGURE_DPI):, :].min() < 128

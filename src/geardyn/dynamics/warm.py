@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import time
 
-__all__ = ["compile_kernels"]
+__all__ = ["compile_kernels", "kernels_compiled"]
 
 
 def compile_kernels() -> float:
@@ -39,3 +39,22 @@ def compile_kernels() -> float:
     stiffness_map = pem_map(case, centre_distance_grid(case), cracked=False)
     simulate(case, stiffness_map, model="II")
     return time.perf_counter() - t0
+
+
+def kernels_compiled() -> bool:
+    """Whether numba's disk cache holds the time-step kernel compiled from these sources for
+    this machine's CPU (then :func:`compile_kernels` only loads it).
+
+    Reads the cache index of :func:`geardyn.dynamics._kernel.advance` (numba invalidates an
+    index whose source file changed) and looks for an entry of this CPU's code generator.
+    Any surprise in numba's internals answers False: the caller then compiles, which is only
+    slower.
+    """
+    try:
+        from ._kernel import advance
+
+        index = advance._cache._cache_file._load_index()
+        magic = advance.targetctx.codegen().magic_tuple()
+        return any(key[1] == magic for key in index)
+    except Exception:  # noqa: BLE001 - numba internals: unknown means not compiled
+        return False

@@ -112,14 +112,21 @@ def _faulty_bodies_in_background(case: Case, result: StudyResult):
 
     if case.stiffness.method != "fe":
         return contextlib.nullcontext(None)
-    from ..dynamics.warm import compile_kernels
-    from ..stiffness.fe.background import faulty_bodies_in_background
+    from ..dynamics.warm import compile_kernels, kernels_compiled
+    from ..stiffness.fe.background import faulty_bodies_in_background, tasks_in_background
 
+    progress = result.sub_progress("stiffness (FE bodies)")
+    if result.quick:
+        # --quick's coarse bodies are built here sooner than a second process could start and
+        # build them; a second process only compiles the time-step kernel meanwhile, and only
+        # when numba has not compiled it yet (the first run after an install)
+        if not kernels_compiled():
+            result.kernel_compiler = tasks_in_background((compile_kernels,))
+        return faulty_bodies_in_background(case, progress=progress, second_process=False)
     # after the bodies, the same process compiles the time-step kernel (a first run after an
     # install; otherwise it loads it in a fraction of a second) while this one evaluates the
     # maps and draws their figures
-    return faulty_bodies_in_background(case, then=(compile_kernels,),
-                                       progress=result.sub_progress("stiffness (FE bodies)"))
+    return faulty_bodies_in_background(case, then=(compile_kernels,), progress=progress)
 
 
 class _ImportedOnCall:
@@ -439,6 +446,11 @@ def _write_run_file(ds, path: Path) -> None:
                  {"float32": RUN_ENCODING_FLOAT32, "compression": COMPRESSION}, write)
 
 
+#: Longest wait [s] for a second process compiling the time-step kernel (it takes 5-10 s on a
+#: 2-core machine); after it, this process compiles the kernel itself.
+KERNEL_COMPILE_WAIT_S = 60.0
+
+
 def simulation_stage(case: Case, out: Path, result: StudyResult) -> None:
     """Model I, I-static and II, cracked and healthy; the paper's flow-chart variant for Fig. 9;
     the model comparison (:func:`model_comparison`).
@@ -450,6 +462,8 @@ def simulation_stage(case: Case, out: Path, result: StudyResult) -> None:
     from . import paper_figures as pf
 
     sim_case = _simulation_case(case, result.quick)
+    if result.kernel_compiler is not None:  # compiling the kernel (stiffness stage): wait for it
+        result.kernel_compiler.join(timeout=KERNEL_COMPILE_WAIT_S)  # rather than compile it too
     runs = {}  # held for this stage's figures and numbers; the later stages read `records`
     records = CachedRecords()
     jobs = [("I", "cracked"), ("I-static", "cracked"), ("II", "cracked"), ("I", "healthy"),

@@ -72,6 +72,9 @@ class StudyResult:
         Physical inputs that differ from the paper's case (``key``, ``paper``, ``case``).
     files : dict of str -> Path
         Files written, by role.
+    kernel_compiler : multiprocessing.Process, optional
+        A second process compiling the time-step kernel (``--quick`` on a first run after an
+        install), which the simulation stage waits for.
     measured_tsa : dict
         ``(variant, state)`` -> TSA of the housing acceleration [m/s^2] over one revolution
         (measurement stage, :mod:`.paper_measurement`).
@@ -87,6 +90,7 @@ class StudyResult:
     progress: Progress | None = None
     quick: bool = False
     sims: dict = field(default_factory=dict)
+    kernel_compiler: object = None
     diagnoses: dict = field(default_factory=dict)
     crack_angle_rad: float | None = None
     paper_case: bool = True
@@ -120,7 +124,7 @@ class RenderedFigure:
         self.png = png
 
     def savefig(self, fh, format: str = "png", **_ignored) -> None:  # noqa: A002 (matplotlib's name)
-        """Write the PNG (rendered at :data:`FIGURE_DPI`, tight bounding box) to ``fh``."""
+        """Write the PNG (rendered at :data:`FIGURE_DPI`, :func:`.report.png_bbox`) to ``fh``."""
         if format != "png":
             raise ValueError(f"a rendered figure is PNG only, not {format!r}")
         fh.write(self.png)
@@ -250,9 +254,9 @@ _SOURCE_DIGEST: str | None = None
 
 class FigureStore(dict):
     """Figure name -> :class:`RenderedFigure`: a matplotlib figure assigned is rendered to PNG
-    (:data:`FIGURE_DPI`, tight bounding box, as the report embeds it) and closed, which keeps a
-    run's memory from growing with every figure (measured: the diagnostics and report stages of
-    ``geardyn run --quick`` held about 560 MB of figures and their data)."""
+    (:data:`FIGURE_DPI`, bounding box by :func:`.report.png_bbox`, as the report embeds it) and
+    closed, which keeps a run's memory from growing with every figure (measured: the diagnostics
+    and report stages of ``geardyn run --quick`` held about 560 MB of figures and their data)."""
 
     def __setitem__(self, key, fig) -> None:
         if not isinstance(fig, RenderedFigure) and hasattr(fig, "savefig"):
@@ -260,8 +264,10 @@ class FigureStore(dict):
 
             import matplotlib.pyplot as plt
 
+            from .report import png_bbox
+
             buf = io.BytesIO()
-            fig.savefig(buf, format="png", dpi=FIGURE_DPI, bbox_inches="tight")
+            fig.savefig(buf, format="png", dpi=FIGURE_DPI, bbox_inches=png_bbox(fig))
             plt.close(fig)
             fig = RenderedFigure(buf.getvalue())
         super().__setitem__(key, fig)

@@ -70,6 +70,17 @@ def _slug(text: str) -> str:
     return re.sub(r"[^a-z0-9]+", "-", text.lower()).strip("-")[:60] or "section"
 
 
+def png_bbox(fig) -> str | None:
+    """``bbox_inches`` for saving ``fig``: ``"tight"`` only for a figure without a layout
+    engine. A constrained-layout figure (every figure of the report) already fits its content
+    to the canvas, and a tight bounding box draws it a second time to measure it: 10-20 % of
+    each figure's saving time (22 figures of ``geardyn run --quick``: 6.9 s tight, 5.9 s
+    without, 2026-11-26)."""
+    engine = getattr(fig, "get_layout_engine", None)  # (a RenderedFigure has none: ignored)
+    return None if engine is not None and engine() is not None else "tight"
+
+
+
 @dataclass
 class Report:
     """An HTML report being assembled.
@@ -129,7 +140,7 @@ class Report:
             The PNG written.
         """
         buf = io.BytesIO()
-        fig.savefig(buf, format="png", dpi=dpi, bbox_inches="tight")
+        fig.savefig(buf, format="png", dpi=dpi, bbox_inches=png_bbox(fig))
         data = buf.getvalue()
         path = self.out / "figures" / f"{name}.png"
         write_bytes_atomic(path, data)

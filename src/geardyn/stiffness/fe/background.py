@@ -36,8 +36,8 @@ import contextlib
 import os
 from collections.abc import Callable
 
-__all__ = ["faulty_bodies_in_background", "BackgroundBodies", "fe_processes",
-           "FE_PROCESSES_ENV", "MIN_AVAILABLE_BYTES"]
+__all__ = ["faulty_bodies_in_background", "tasks_in_background", "BackgroundBodies",
+           "fe_processes", "FE_PROCESSES_ENV", "MIN_AVAILABLE_BYTES"]
 
 #: Environment variable: 0 (one process), 1 (a second process builds the faulty bodies).
 FE_PROCESSES_ENV = "GEARDYN_FE_PROCESSES"
@@ -103,6 +103,44 @@ def _build_faulty_bodies(case, then: tuple = (), cache_root: str | None = None) 
             task()
     except Exception:  # noqa: BLE001 - reported by the first process, which meets it too
         sys.exit(1)
+
+
+def _run_tasks(tasks: tuple) -> None:
+    """In a second process: call each of ``tasks``; an error ends the process quietly (exit
+    status 1: the first process does the same work when it needs it, and reports its errors)."""
+    import signal
+    import sys
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the first process's business
+    try:
+        for task in tasks:
+            task()
+    except Exception:  # noqa: BLE001 - met again, and reported, by the first process
+        sys.exit(1)
+
+
+def tasks_in_background(tasks: tuple):
+    """Start a second process that calls ``tasks`` (module-level functions without arguments,
+    e.g. :func:`geardyn.dynamics.warm.compile_kernels`) and is left to run: a daemon, spawned
+    and started like the bodies' process (:func:`_start_quietly`), stopped if this process
+    ends first. Nothing is started where ``GEARDYN_FE_PROCESSES`` is 0, in a daemon process, or
+    when no process can be had.
+
+    Returns
+    -------
+    multiprocessing.Process or None
+    """
+    import multiprocessing
+
+    if fe_processes() == 0 or multiprocessing.current_process().daemon or not tasks:
+        return None
+    proc = multiprocessing.get_context("spawn").Process(
+        target=_run_tasks, args=(tuple(tasks),), name="geardyn-background", daemon=True)
+    try:
+        _start_quietly(proc)
+    except (OSError, RuntimeError):
+        return None
+    return proc
 
 
 @contextlib.contextmanager
@@ -205,7 +243,8 @@ class BackgroundBodies:
 @contextlib.contextmanager
 def faulty_bodies_in_background(case, *, method: str | None = None, cache=None,
                                 then: tuple = (),
-                                progress: Callable[[int, int], None] | None = None):
+                                progress: Callable[[int, int], None] | None = None,
+                                second_process: bool = True):
     """While the block runs, a second process builds the FE bodies of ``case``'s faulty map
     into the cache (when that helps and is allowed: module docstring); without one, this
     process builds them before the block, faulty body first (``progress(done, total)`` over
@@ -219,13 +258,14 @@ def faulty_bodies_in_background(case, *, method: str | None = None, cache=None,
     bodies the block has then usually loaded already), unless there is ``then`` work, which goes
     on after the block; on an exception (Ctrl-C included) it stops the process at once. The
     process's own errors are not raised here: the block builds whatever the process did not,
-    and raises the error itself.
+    and raises the error itself. ``second_process=False`` builds the bodies in this process
+    (before the block) whatever the machine allows.
     """
     from ...cache import default_cache
 
     cache = cache or default_cache()
     proc = None
-    if _wanted(case, cache, method or case.stiffness.method):
+    if second_process and _wanted(case, cache, method or case.stiffness.method):
         import multiprocessing
 
         proc = multiprocessing.get_context("spawn").Process(

@@ -1,0 +1,79 @@
+"""Work left to a second process (``tasks_in_background``) and the check that tells whether the
+time-step kernel needs compiling (``kernels_compiled``), which ``geardyn run --quick`` uses to
+compile the kernel in a second process on a first run after an install (issue 16.6)."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import textwrap
+
+import pytest
+
+from geardyn.stiffness.fe.background import FE_PROCESSES_ENV, tasks_in_background
+
+MARK_ENV = "GEARDYN_TEST_BACKGROUND_MARK"
+
+
+def write_mark() -> None:
+    """A task: write the process id into the file named by the environment."""
+    with open(os.environ[MARK_ENV], "w", encoding="ascii") as fh:
+        fh.write(str(os.getpid()))
+
+
+def fail() -> None:
+    raise RuntimeError("a task that fails")
+
+
+def test_the_tasks_run_in_another_process(tmp_path, monkeypatch):
+    mark = tmp_path / "mark"
+    monkeypatch.setenv(MARK_ENV, str(mark))
+    monkeypatch.setenv(FE_PROCESSES_ENV, "1")
+    proc = tasks_in_background((write_mark,))
+    assert proc is not None
+    proc.join(timeout=60)
+    assert proc.exitcode == 0
+    assert int(mark.read_text()) == proc.pid != os.getpid()
+
+
+def test_a_failing_task_ends_the_process_quietly_and_the_rest_is_not_run(tmp_path, monkeypatch,
+                                                                        capfd):
+    mark = tmp_path / "mark"
+    monkeypatch.setenv(MARK_ENV, str(mark))
+    monkeypatch.setenv(FE_PROCESSES_ENV, "1")
+    proc = tasks_in_background((fail, write_mark))
+    proc.join(timeout=60)
+    assert proc.exitcode == 1 and not mark.exists()
+    assert "Traceback" not in capfd.readouterr().err
+
+
+def test_no_second_process_where_one_is_asked_for(tmp_path, monkeypatch):
+    monkeypatch.setenv(MARK_ENV, str(tmp_path / "mark"))
+    monkeypatch.setenv(FE_PROCESSES_ENV, "0")
+    assert tasks_in_background((write_mark,)) is None
+    monkeypatch.setenv(FE_PROCESSES_ENV, "1")
+    assert tasks_in_background(()) is None
+    assert not (tmp_path / "mark").exists()
+
+
+@pytest.mark.slow
+def test_kernels_compiled_before_and_after_compiling_them(tmp_path):
+    """In a fresh numba cache the kernel is not compiled; after ``compile_kernels`` it is, and a
+    new process (which only loads it) says so too."""
+    code = textwrap.dedent("""
+        import sys
+        from geardyn.dynamics.warm import compile_kernels, kernels_compiled
+        before = kernels_compiled()
+        if sys.argv[1] == "compile":
+            compile_kernels()
+        print(before, kernels_compiled())
+    """)
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba"))
+    first = subprocess.run([sys.executable, "-c", code, "compile"], env=env, text=True,
+                           capture_output=True, timeout=300)
+    assert first.returncode == 0, first.stderr
+    assert first.stdout.split() == ["False", "True"]
+    again = subprocess.run([sys.executable, "-c", code, "look"], env=env, text=True,
+                           capture_output=True, timeout=300)
+    assert again.stdout.split() == ["True", "True"], again.stderr
