@@ -77,3 +77,38 @@ def test_kernels_compiled_before_and_after_compiling_them(tmp_path):
     again = subprocess.run([sys.executable, "-c", code, "look"], env=env, text=True,
                            capture_output=True, timeout=300)
     assert again.stdout.split() == ["True", "True"], again.stderr
+
+
+@pytest.mark.parametrize("compiled", [True, False])
+def test_quick_compiles_the_kernel_in_a_second_process_only_when_numba_has_not(monkeypatch,
+                                                                               compiled):
+    """``geardyn run --quick``: with the kernel not yet compiled, a second process compiles it
+    and this one builds the coarse bodies; once compiled, the second process builds the faulty
+    bodies (then loads the kernel), as in a full run. A full run never asks."""
+    import geardyn
+    from geardyn.dynamics import warm
+    from geardyn.stiffness.fe import background as bg
+    from geardyn.studies import paper
+    from geardyn.studies.paper_result import StudyResult
+
+    calls = []
+    monkeypatch.setattr(warm, "kernels_compiled", lambda: calls.append("asked") or compiled)
+    monkeypatch.setattr(bg, "tasks_in_background", lambda tasks: calls.append(("tasks", tasks))
+                        or "a process")
+    monkeypatch.setattr(bg, "faulty_bodies_in_background",
+                        lambda case, **kw: calls.append(("bodies", sorted(kw.items()))))
+    case = geardyn.paper_case().with_overrides({"stiffness.method": "fe"})
+    for quick in (True, False):
+        result = StudyResult(out=None, quick=quick)
+        paper._faulty_bodies_in_background(case, result)
+        assert result.kernel_compiler == (None if compiled or not quick else "a process")
+    quick_calls = calls[:3] if not compiled else calls[:2]
+    if compiled:
+        assert quick_calls == ["asked", ("bodies", [("progress", None),
+                                                    ("then", (warm.compile_kernels,))])]
+    else:
+        assert quick_calls == ["asked", ("tasks", (warm.compile_kernels,)),
+                               ("bodies", [("progress", None), ("second_process", False)])]
+    # the full run: the bodies' process, the kernel after them; the cache of the kernel not read
+    assert calls[len(quick_calls):] == [("bodies", [("progress", None),
+                                                    ("then", (warm.compile_kernels,))])]
