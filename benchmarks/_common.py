@@ -65,8 +65,25 @@ def best_time(fn: Callable[[], object], repeat: int = 3, number: int = 1) -> flo
     return best
 
 
-def _tree_rss_kb(root: int) -> int:
-    """Resident memory [kB] of ``root`` and all its descendants now (Linux ``/proc``)."""
+def _pss_kb(pid: int) -> int:
+    """Proportional set size [kB] of ``pid`` (``/proc/<pid>/smaps_rollup``): its resident pages,
+    each shared page divided among the processes sharing it; 0 where unreadable."""
+    try:
+        with open(f"/proc/{pid}/smaps_rollup") as fh:
+            for line in fh:
+                if line.startswith("Pss:"):
+                    return int(line.split()[1])
+    except (OSError, IndexError, ValueError):
+        return 0
+    return 0
+
+
+def _tree_rss_kb(root: int) -> tuple[int, int]:
+    """Resident memory [kB] of ``root`` and all its descendants now (Linux ``/proc``): the sum
+    of their resident sets, and the sum of their proportional set sizes (:func:`_pss_kb`),
+    which counts a page shared by several of them once: the libraries every Python process
+    maps, and a process forked from another before it executes a new program (a spawned
+    worker's first milliseconds), which the sum of resident sets counts twice."""
     import os
 
     parent: dict[int, int] = {}
@@ -90,15 +107,16 @@ def _tree_rss_kb(root: int) -> int:
             if par == p and child not in tree:
                 tree.add(child)
                 frontier.append(child)
-    return sum(rss.get(p, 0) for p in tree)
+    return sum(rss.get(p, 0) for p in tree), sum(_pss_kb(p) for p in tree)
 
 
 def run_measured(cmd: list[str], env: dict, *, interval: float = 0.05
-                 ) -> tuple[float, float, float]:
+                 ) -> tuple[float, float, float, float]:
     """Run ``cmd``; return its wall time [s], the peak of the *summed* resident memory of the
     process and its children [MB] (sampled every ``interval`` s from ``/proc``; 0 where there
-    is none) and its own peak resident set [MB] (``ru_maxrss`` from ``wait4``: the largest single
-    process of the tree, not their sum).
+    is none), its own peak resident set [MB] (``ru_maxrss`` from ``wait4``: the largest single
+    process of the tree, not their sum) and the peak of their summed proportional set sizes
+    [MB] (:func:`_tree_rss_kb`: shared pages counted once; 0 where ``/proc`` has none).
 
     Raises ``RuntimeError`` with the command's stderr if it fails.
     """
@@ -107,7 +125,7 @@ def run_measured(cmd: list[str], env: dict, *, interval: float = 0.05
     import tempfile
     import threading
 
-    peak = [0]
+    peak = [0, 0]
     t0 = time.perf_counter()
     with tempfile.TemporaryFile() as err:
         p = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=err)
@@ -116,7 +134,8 @@ def run_measured(cmd: list[str], env: dict, *, interval: float = 0.05
         def sample() -> None:
             while not done.is_set():
                 if os.path.isdir("/proc"):
-                    peak[0] = max(peak[0], _tree_rss_kb(p.pid))
+                    rss, pss = _tree_rss_kb(p.pid)
+                    peak[0], peak[1] = max(peak[0], rss), max(peak[1], pss)
                 done.wait(interval)
 
         th = threading.Thread(target=sample, daemon=True)
@@ -128,4 +147,4 @@ def run_measured(cmd: list[str], env: dict, *, interval: float = 0.05
         if os.waitstatus_to_exitcode(status) != 0:
             err.seek(0)
             raise RuntimeError(f"{' '.join(cmd)} failed:\n{err.read().decode()}")
-    return wall, peak[0] / 1024.0, usage.ru_maxrss / 1024.0
+    return wall, peak[0] / 1024.0, usage.ru_maxrss / 1024.0, peak[1] / 1024.0

@@ -10,7 +10,10 @@ measured in the same session. Peak memory is the peak of the resident memory sum
 command's processes (sampled from ``/proc``; the FE bodies of a faulty map may be built by a second
 process, ``geardyn.stiffness.fe.background``). The last two cold runs have a compiled numba cache:
 one with the default (a second FE process where the machine allows), one with
-``GEARDYN_FE_PROCESSES=0``; then ``--quick`` again on an empty geardyn cache, numba compiled.
+``GEARDYN_FE_PROCESSES=0``; then ``--quick`` again on an empty geardyn cache, numba compiled,
+with the default (second processes for the FE bodies and the figures,
+``geardyn.studies.figure_process``) and in one process. Memory is also given as the peak of the
+summed proportional set sizes, which counts a page shared by two processes once.
 """
 
 from __future__ import annotations
@@ -23,13 +26,18 @@ from pathlib import Path
 from _common import Row, run_measured
 
 _PEAK_MB: dict[str, float] = {}
+_PEAK_PSS_MB: dict[str, float] = {}
 
 
 def _run(args: list[str], env: dict) -> float:
     """Wall time [s] of ``geardyn run args``; its peak memory summed over its processes [MB]
-    into ``_PEAK_MB`` (sampled from ``/proc``: the FE bodies may use a second process)."""
-    wall, peak, _largest = run_measured([sys.executable, "-m", "geardyn", "run", *args], env)
+    into ``_PEAK_MB`` (resident sets) and ``_PEAK_PSS_MB`` (proportional set sizes: shared
+    pages once), sampled from ``/proc`` (the FE bodies and the figures may use second
+    processes)."""
+    wall, peak, _largest, pss = run_measured([sys.executable, "-m", "geardyn", "run", *args],
+                                             env)
     _PEAK_MB[" ".join(args)] = peak
+    _PEAK_PSS_MB[" ".join(args)] = pss
     return wall
 
 
@@ -60,23 +68,40 @@ def run(quick: bool) -> list[Row]:
         env_q2 = dict(env_two, GEARDYN_CACHE_DIR=str(tmp / "cache5"))
         q2_args = ["--quick", "--out", str(tmp / "q2"), *extra]
         t_quick2 = _run(q2_args, env_q2)
+        # the same in one process (no second process for the FE bodies or the figures)
+        env_q1 = dict(env_q2, GEARDYN_CACHE_DIR=str(tmp / "cache6"), GEARDYN_FE_PROCESSES="0")
+        q1_args = ["--quick", "--out", str(tmp / "q1"), *extra]
+        t_quick1 = _run(q1_args, env_q1)
     label = " (pem)" if quick else ""
     mem_one, mem_two = _PEAK_MB[" ".join(one_args)], _PEAK_MB[" ".join(two_args)]
+    mem_q2, mem_q1 = _PEAK_MB[" ".join(q2_args)], _PEAK_MB[" ".join(q1_args)]
+    pss = {k: _PEAK_PSS_MB[" ".join(a)] for k, a in
+           (("quick", quick_args), ("cold", cold_args), ("two", two_args), ("one", one_args))}
     return [
         Row(f"geardyn run --quick, cold{label}", t_quick, "s", target="< 15 s (issue 16)",
             met=t_quick < 15),
         Row(f"geardyn run --quick, cold geardyn cache, numba compiled{label}", t_quick2, "s",
             "nothing compiled (the row above)", t_quick, "< 15 s", t_quick2 < 15),
+        Row(f"  same in one process (GEARDYN_FE_PROCESSES=0){label}", t_quick1, "s",
+            "the default (the row above)", t_quick2, "< 15 s", t_quick1 < 15),
+        Row(f"  their peak memory, default / one process{label}", mem_q2, "MB",
+            "one process", mem_q1, "< 600 MB", mem_q2 < 600),
         Row(f"geardyn run --quick, cold, peak memory{label}", mem_quick, "MB",
             target="< 600 MB", met=mem_quick < 600),
+        Row(f"  the same as proportional set sizes (shared pages once){label}", pss["quick"],
+            "MB", target="< 600 MB", met=pss["quick"] < 600),
         Row(f"geardyn run, cold, peak memory{label}", mem_cold, "MB", target="< 600 MB",
             met=mem_cold < 600),
+        Row(f"  the same as proportional set sizes{label}", pss["cold"], "MB",
+            target="< 600 MB", met=pss["cold"] < 600),
         Row(f"geardyn run, cold{label}", t_cold, "s", target="< 40 s", met=t_cold < 40),
         Row(f"geardyn run, cold geardyn cache, numba compiled, FE bodies by the default{label}",
             t_two, "s", "same in one process (GEARDYN_FE_PROCESSES=0)", t_one, "< 40 s",
             t_two < 40),
         Row(f"  its peak memory, summed over its processes{label}", mem_two, "MB",
             "one process", mem_one, "< 600 MB", mem_two < 600),
+        Row(f"  the same as proportional set sizes{label}", pss["two"], "MB",
+            "one process", pss["one"], "< 600 MB", pss["two"] < 600),
         Row(f"geardyn run, first warm run into a new folder{label}", t_warm[0], "s",
             "the same run cold", t_cold, target="< 5 s", met=t_warm[0] < 5),
         Row(f"geardyn run, warm into a new folder, slowest of the next 2{label}", max(t_warm[1:]),

@@ -43,7 +43,7 @@ import numpy as np
 from ..config import Case, case_to_toml, paper_case
 from ..geometry import geometry_summary, static_operating_point
 from ..io import write_json_atomic, write_text_atomic
-from .paper_result import Progress, StudyResult
+from .paper_result import FigureStore, Progress, StudyResult
 from .paper_validation import validation_tables
 from .paper_values import (
     CONDITION_METRICS,
@@ -124,11 +124,25 @@ def _faulty_bodies_in_background(case: Case, result: StudyResult):
         # second process builds the faulty bodies as in a full run (21.0-21.4 s against
         # 22.7-22.8 s with the bodies here; 665 MB against 484 MB)
         result.kernel_compiler = tasks_in_background((compile_kernels,))
+        if result.kernel_compiler is not None:
+            result.background.append(result.kernel_compiler)
         return faulty_bodies_in_background(case, progress=progress, second_process=False)
-    # after the bodies, the same process compiles the time-step kernel (a first run after an
-    # install; otherwise it loads it in a fraction of a second) while this one evaluates the
-    # maps and draws their figures
-    return faulty_bodies_in_background(case, then=(compile_kernels,), progress=progress)
+    # on a first run after an install, the same process then compiles the time-step kernel
+    # while this one evaluates the maps and goes on; with the kernel compiled it ends with the
+    # bodies (loading the kernel there would not load it here) and the block waits for it
+    then = () if kernels_compiled() else (compile_kernels,)
+    return faulty_bodies_in_background(case, then=then, progress=progress)
+
+
+def _figure_process(result: StudyResult):
+    """A :class:`~.figure_process.FigureProcess` for the study's figures where a second
+    process is allowed (:func:`~.figure_process.figure_process_allowed`), started once the
+    study's other background processes (``result.background``) have ended; else None."""
+    from .figure_process import FigureProcess, figure_process_allowed
+
+    if not figure_process_allowed():
+        return None
+    return FigureProcess(ready=lambda: not any(p.is_alive() for p in result.background))
 
 
 class _ImportedOnCall:
@@ -169,9 +183,11 @@ def stiffness_stage(case: Case, out: Path, result: StudyResult) -> None:
         result.notes.append("--quick: the stiffness maps are coarser than the case's ("
                             + ", ".join(what) + "); run without --quick for the case's own "
                             "maps.")
-    with warnings.catch_warnings(), _faulty_bodies_in_background(map_case, result):
+    with warnings.catch_warnings(), _faulty_bodies_in_background(map_case, result) as bodies:
         # (a second process builds the cracked map's FE bodies meanwhile, where cores and
         # memory allow: geardyn.stiffness.fe.background)
+        if bodies:
+            result.background.append(bodies.process)
         warnings.simplefilter("ignore")  # the maps record their warnings in attrs (read below)
         healthy = _build_map_with_progress(build_map, map_case, False, result,
                                            "stiffness (healthy)")
@@ -194,9 +210,10 @@ def stiffness_stage(case: Case, out: Path, result: StudyResult) -> None:
         # imported only to draw: the FE package takes 0.2 s to import (issue 16)
         plot_mesh = _ImportedOnCall("geardyn.stiffness.fe", "plot_mesh")
         # the mesh the maps were built on (with --quick, the coarser one, which is also the one
-        # build_body_mesh has just made and still holds)
+        # build_body_mesh has just made and still holds: drawn here, not by a figure process,
+        # which would mesh the body again)
         result.summary["fe_mesh_refinement"] = float(map_case.stiffness.fe.refinement)
-        result.figures.cached("fig_fe_mesh", plot_mesh, map_case,
+        result.figures.cached_here("fig_fe_mesh", plot_mesh, map_case,
                               cracked=case.crack is not None and case.crack.active)
     cracks = case.crack is not None and case.crack.active
     dd_op = result.summary.get("static", {}).get("centre_distance_change_mm", 0.0) * 1e-3
@@ -849,6 +866,7 @@ def run_paper_study(case: Case | None = None, out: str | Path = "geardyn-out", *
     inputs, numerical = case_differences(case)
     result = StudyResult(out=out, progress=progress, quick=quick, paper_case=not inputs,
                          differences=inputs)
+    result.figures = FigureStore(_figure_process(result))
     result.summary.update({"case": case.name, "quick": quick,
                            "stiffness_method": case.stiffness.method, "complete": False,
                            "paper_case": not inputs, "differences_from_paper": inputs,
@@ -857,16 +875,19 @@ def run_paper_study(case: Case | None = None, out: str | Path = "geardyn-out", *
         result.summary["calibrated_speed_rad_s"] = float(case.load.speed)
     write_text_atomic(out / "case.toml", case_to_toml(case))
     t_start = time.perf_counter()
-    for i, (name, stage) in enumerate(STAGES):
-        result.emit(name, i, len(STAGES))
-        t0 = time.perf_counter()
-        stage(case, out, result)
-        result.seconds[name] = time.perf_counter() - t0
-        result.stages.append(name)
-        result.summary["stages"] = list(result.stages)
-        result.summary["run_time_s"] = dict(result.seconds)
-        _validate(result)
-        write_json_atomic(out / "summary.json", result.summary)
+    try:
+        for i, (name, stage) in enumerate(STAGES):
+            result.emit(name, i, len(STAGES))
+            t0 = time.perf_counter()
+            stage(case, out, result)
+            result.seconds[name] = time.perf_counter() - t0
+            result.stages.append(name)
+            result.summary["stages"] = list(result.stages)
+            result.summary["run_time_s"] = dict(result.seconds)
+            _validate(result)
+            write_json_atomic(out / "summary.json", result.summary)
+    finally:
+        result.figures.close()  # the figure process, if any, stopped (an error, Ctrl-C)
     result.emit("done", len(STAGES), len(STAGES))
     result.summary["complete"] = True
     result.summary["run_time_s"] = {**result.seconds, "total": time.perf_counter() - t_start}

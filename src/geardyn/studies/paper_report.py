@@ -588,6 +588,9 @@ def report_stage(case: Case, out: Path, result: StudyResult) -> None:
     result.emit("report: results.nc", 0, n_fig + 2)
     write_results_netcdf(out / "results.nc", result, case)
     result.files["results"] = out / "results.nc"
+    # the figures a second process has been drawing: this process draws those it has not
+    # started (geardyn.studies.figure_process)
+    result.figures.finish()
     if paper:
         title = "geardyn: the Xue & Howard (2018) case study"
         subtitle = f"case '{case.name}': {case.description}"

@@ -29,7 +29,8 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
-__all__ = ["StudyResult", "Progress", "Deferred", "FigureStore", "RenderedFigure"]
+__all__ = ["StudyResult", "Progress", "Deferred", "FigureStore", "RenderedFigure",
+           "render_png"]
 
 Progress = Callable[[str, int, int], None]
 
@@ -75,6 +76,9 @@ class StudyResult:
     kernel_compiler : multiprocessing.Process, optional
         A second process compiling the time-step kernel (``--quick`` on a first run after an
         install), which the simulation stage waits for.
+    background : list of multiprocessing.Process
+        The study's other second processes (FE bodies, kernel compiler): the figure process
+        (:mod:`.figure_process`) starts when they have all ended.
     measured_tsa : dict
         ``(variant, state)`` -> TSA of the housing acceleration [m/s^2] over one revolution
         (measurement stage, :mod:`.paper_measurement`).
@@ -91,6 +95,7 @@ class StudyResult:
     quick: bool = False
     sims: dict = field(default_factory=dict)
     kernel_compiler: object = None
+    background: list = field(default_factory=list)
     diagnoses: dict = field(default_factory=dict)
     crack_angle_rad: float | None = None
     paper_case: bool = True
@@ -252,25 +257,141 @@ def _source_digest() -> str:
 _SOURCE_DIGEST: str | None = None
 
 
+def render_png(fig) -> bytes:
+    """A matplotlib figure as PNG bytes (:data:`FIGURE_DPI`, bounding box by
+    :func:`.report.png_bbox`, as the report embeds it); the figure is closed."""
+    import io
+
+    import matplotlib.pyplot as plt
+
+    from .report import png_bbox
+
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=FIGURE_DPI, bbox_inches=png_bbox(fig))
+    plt.close(fig)
+    return buf.getvalue()
+
+
+class _Pending:
+    """A figure handed to the figure process (or held for it): its cache key, how to draw it
+    here, and the PNG to come (``future``, None while held). The arguments are let go as soon
+    as the process has drawn the figure (they are only needed to draw it here instead), so the
+    records and diagnoses a figure shows are not held until the report collects it."""
+
+    __slots__ = ("digest", "draw", "args", "kwargs", "future")
+
+    def __init__(self, digest: str | None, draw: Callable, args: tuple, kwargs: dict):
+        self.digest, self.draw, self.args, self.kwargs = digest, draw, args, kwargs
+        self.future = None
+
+    def send(self, process) -> bool:
+        """Hand the figure to ``process``; False if it does not take it now."""
+        self.future = process.submit(self.draw, self.args, self.kwargs)
+        if self.future is None:
+            return False
+        self.future.add_done_callback(self._drawn)
+        return True
+
+    def _drawn(self, future) -> None:
+        if not future.cancelled() and future.exception() is None:
+            self.args, self.kwargs = (), {}
+
+
 class FigureStore(dict):
     """Figure name -> :class:`RenderedFigure`: a matplotlib figure assigned is rendered to PNG
-    (:data:`FIGURE_DPI`, bounding box by :func:`.report.png_bbox`, as the report embeds it) and
-    closed, which keeps a run's memory from growing with every figure (measured: the diagnostics
-    and report stages of ``geardyn run --quick`` held about 560 MB of figures and their data)."""
+    (:func:`render_png`) and closed, which keeps a run's memory from growing with every figure
+    (measured: the diagnostics and report stages of ``geardyn run --quick`` held about 560 MB of
+    figures and their data).
+
+    With a :class:`~.figure_process.FigureProcess` (``process``), :meth:`cached` hands the
+    figures it has to draw to that second process and returns at once; reading a figure
+    (``store[name]``, ``get``, ``items``, ``values``) or :meth:`finish` collects them.
+    """
+
+    def __init__(self, process=None):
+        super().__init__()
+        self.process = process
 
     def __setitem__(self, key, fig) -> None:
-        if not isinstance(fig, RenderedFigure) and hasattr(fig, "savefig"):
-            import io
-
-            import matplotlib.pyplot as plt
-
-            from .report import png_bbox
-
-            buf = io.BytesIO()
-            fig.savefig(buf, format="png", dpi=FIGURE_DPI, bbox_inches=png_bbox(fig))
-            plt.close(fig)
-            fig = RenderedFigure(buf.getvalue())
+        if not isinstance(fig, (RenderedFigure, _Pending)) and hasattr(fig, "savefig"):
+            fig = RenderedFigure(render_png(fig))
         super().__setitem__(key, fig)
+
+    def __getitem__(self, key):
+        value = super().__getitem__(key)
+        if isinstance(value, _Pending):
+            value = self._collect(key, value)
+        return value
+
+    def get(self, key, default=None):
+        return self[key] if key in self else default
+
+    def items(self):
+        self.finish()
+        return super().items()
+
+    def values(self):
+        self.finish()
+        return super().values()
+
+    def _pending(self) -> list:
+        return [k for k, v in super().items() if isinstance(v, _Pending)]
+
+    def _send_held(self) -> None:
+        """Hand the held figures, in order, to the process if it takes them now."""
+        if self.process is None:
+            return
+        for key in self._pending():
+            job = super().__getitem__(key)
+            if job.future is None and not job.send(self.process):
+                return
+
+    def _collect(self, key, job: _Pending) -> RenderedFigure:
+        """The figure of ``job``: the process's PNG, or drawn here when the process did not
+        draw it (held, cancelled, failed); stored in the figure cache."""
+        png = None
+        if job.future is not None and not job.future.cancelled():
+            try:
+                png = job.future.result()
+            except Exception:  # noqa: BLE001 - drawn again below, which raises it here
+                png = None
+        if png is None:
+            png = render_png(job.draw(*job.args, **job.kwargs))
+        if job.digest is not None:
+            from ..cache import default_cache
+
+            png, _ = default_cache().get_or_build(
+                "figure", job.digest, ".png", lambda: png,
+                lambda data, path: Path(path).write_bytes(data),
+                lambda path: Path(path).read_bytes())
+        figure = RenderedFigure(png)
+        super().__setitem__(key, figure)
+        return figure
+
+    def finish(self) -> None:
+        """Collect every figure handed to the process: this process draws, from the last one
+        back, each the process has not started, while the process goes on from the first; then
+        the process is stopped. Cheap when nothing is pending."""
+        pending = self._pending()
+        if not pending:
+            return
+        self._send_held()
+        for key in reversed(pending):
+            job = super().__getitem__(key)
+            if job.future is None or job.future.cancel():
+                job.future = None
+                self._collect(key, job)
+        for key in pending:
+            job = super().__getitem__(key)
+            if isinstance(job, _Pending):
+                self._collect(key, job)
+        self.close()
+
+    def close(self) -> None:
+        """Stop the figure process (queued figures dropped); later figures are drawn here."""
+        if self.process is not None:
+            self.process.close()
+            self.process = None
 
     def cached(self, key, draw: Callable, *args, **kwargs) -> None:
         """``self[key] = draw(*args, **kwargs)``, through the disk cache (kind ``figure``): the
@@ -278,7 +399,18 @@ class FigureStore(dict):
         geardyn's sources, so a run whose inputs did not change takes its figures from the
         cache instead of drawing them again (issue 16.6). A :class:`Deferred` argument counts
         by its fingerprint and is computed only when the figure is drawn. Arguments it cannot
-        fingerprint, or ``GEARDYN_NO_CACHE``, draw the figure as before."""
+        fingerprint, or ``GEARDYN_NO_CACHE``, draw the figure without the cache. With a figure
+        process, a figure not in the cache is handed to it (its :class:`Deferred` arguments
+        computed here first) and collected later (class docstring)."""
+        self._cached(key, draw, args, kwargs, here=False)
+
+    def cached_here(self, key, draw: Callable, *args, **kwargs) -> None:
+        """:meth:`cached`, drawn by this process even with a figure process: for a figure whose
+        drawing reuses what this process holds (e.g. the FE mesh it has just built, which the
+        figure process would build again)."""
+        self._cached(key, draw, args, kwargs, here=True)
+
+    def _cached(self, key, draw: Callable, args: tuple, kwargs: dict, here: bool) -> None:
         import hashlib
 
         from ..cache import default_cache
@@ -289,16 +421,36 @@ class FigureStore(dict):
             _digest(kwargs, h)
         except _Undigestable:
             args, kwargs = _resolve(args, kwargs)
-            self[key] = draw(*args, **kwargs)
+            if self.process is not None and not here:
+                self._hand_over(key, None, draw, args, kwargs)
+            else:
+                self[key] = draw(*args, **kwargs)
             return
         h.update(_source_digest().encode())
+        cache = default_cache()
+        digest = h.hexdigest()
+        if self.process is not None and not here and not (
+                cache.enabled and cache.path("figure", digest, ".png").exists()):
+            # the figure process draws it; it goes into the cache when collected
+            self._hand_over(key, digest if cache.enabled else None, draw,
+                            *_resolve(args, kwargs))
+            return
 
         def build() -> bytes:
             a, kw = _resolve(args, kwargs)
             self[key] = draw(*a, **kw)
             return dict.__getitem__(self, key).png
 
-        png, _ = default_cache().get_or_build("figure", h.hexdigest(), ".png", build,
-                                              lambda data, path: Path(path).write_bytes(data),
-                                              lambda path: Path(path).read_bytes())
+        png, _ = cache.get_or_build("figure", digest, ".png", build,
+                                    lambda data, path: Path(path).write_bytes(data),
+                                    lambda path: Path(path).read_bytes())
         super().__setitem__(key, RenderedFigure(png))
+
+    def _hand_over(self, key, digest: str | None, draw: Callable, args: tuple,
+                   kwargs: dict) -> None:
+        """Hand ``draw(*args, **kwargs)`` to the figure process (held until it starts), after
+        the figures held before it; ``digest``: its figure-cache key (None: not cached)."""
+        self._send_held()
+        job = _Pending(digest, draw, args, kwargs)
+        job.send(self.process)
+        super().__setitem__(key, job)

@@ -37,7 +37,8 @@ import os
 from collections.abc import Callable
 
 __all__ = ["faulty_bodies_in_background", "tasks_in_background", "BackgroundBodies",
-           "fe_processes", "FE_PROCESSES_ENV", "MIN_AVAILABLE_BYTES"]
+           "fe_processes", "starting_quietly", "FE_PROCESSES_ENV",
+           "MIN_AVAILABLE_BYTES"]
 
 #: Environment variable: 0 (one process), 1 (a second process builds the faulty bodies).
 FE_PROCESSES_ENV = "GEARDYN_FE_PROCESSES"
@@ -173,23 +174,33 @@ def _without_main_module():
             setattr(main, name, value)
 
 
-def _start_quietly(proc) -> None:
-    """Start ``proc`` without the parent's main script (:func:`_without_main_module`) and with
-    Ctrl-C ignored from its first instruction: a new interpreter keeps an ignored SIGINT
-    ignored, so a Ctrl-C while it imports prints no traceback of it (the first process reports
-    the interruption and stops it)."""
+@contextlib.contextmanager
+def starting_quietly():
+    """While the block starts a spawned process (``Process.start()``, or the first ``submit``
+    of a spawning process pool): the parent's main script hidden (:func:`_without_main_module`)
+    and Ctrl-C ignored, so the new interpreter ignores it from its first instruction (an ignored
+    SIGINT stays ignored across ``exec``) and a Ctrl-C while it imports prints no traceback of
+    it (the first process reports the interruption and stops it). Outside the main thread
+    signals cannot be changed, and the block runs with only the main script hidden."""
     import signal
 
+    unchanged = object()
     with _without_main_module():
         try:
             old = signal.signal(signal.SIGINT, signal.SIG_IGN)
-        except ValueError:  # not the main thread: start it as it is
-            proc.start()
-            return
+        except ValueError:  # not the main thread
+            old = unchanged
         try:
-            proc.start()
+            yield
         finally:
-            signal.signal(signal.SIGINT, old)
+            if old is not unchanged:
+                signal.signal(signal.SIGINT, old)
+
+
+def _start_quietly(proc) -> None:
+    """Start ``proc`` as :func:`starting_quietly` says."""
+    with starting_quietly():
+        proc.start()
 
 
 def _faulty_bodies_missing(case, cache, method: str) -> bool:

@@ -1,0 +1,131 @@
+"""Report figures drawn by a second process while the study goes on (issue 16.6: "figures
+rendered in parallel").
+
+Drawing and saving its 22 figures was half of a cold ``geardyn run --quick`` (about 11 s of
+21 s on the 2-core machine, measured 2026-11-26: 8.0 s in ``savefig`` alone). matplotlib holds
+the interpreter lock, so a drawing thread gained nothing (measured and rejected); a second
+process does. :class:`FigureProcess` is a one-worker, spawned process pool: the study hands it
+each figure it would have drawn (the drawing function and its arguments, pickled) and goes on
+with its own work; :meth:`.paper_result.FigureStore.finish` then collects the PNGs and draws
+itself, from the end of the queue, every figure the worker has not started, so the two
+processes meet in the middle instead of one waiting for the other.
+
+The PNG bytes are the same as a figure drawn in this process (the same function, matplotlib
+and fonts; ``tests/studies/test_figure_process.py``). The process is an accelerator only: a
+figure it cannot draw (an error, a broken pool, arguments that do not pickle) is drawn again in
+this process, which raises the error, if any, with its own traceback.
+
+It costs memory: a second interpreter with matplotlib, xarray and geardyn imported (about
+150-200 MB). It is used where the FE bodies' second process would be
+(:func:`geardyn.stiffness.fe.background.fe_processes`: ``GEARDYN_FE_PROCESSES=0`` runs
+everything in one process), not from a daemon process (a pool's worker may not have children),
+and it starts only when ``ready()`` says so: the study waits until its other background
+processes (the FE bodies, the kernel compiler) have ended, so that no more than two processes
+are alive at once; figures handed over before then are held and sent when it starts.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+__all__ = ["FigureProcess", "figure_process_allowed", "draw_png"]
+
+
+def figure_process_allowed() -> bool:
+    """Whether a second process may draw figures: as for the FE bodies' second process
+    (:func:`geardyn.stiffness.fe.background.fe_processes`), and not from a daemon process.
+
+    Raises
+    ------
+    ValueError
+        ``GEARDYN_FE_PROCESSES`` set to anything but 0 or 1.
+    """
+    import multiprocessing
+
+    from ..stiffness.fe.background import fe_processes
+
+    return fe_processes() == 1 and not multiprocessing.current_process().daemon
+
+
+def draw_png(draw: Callable, args: tuple, kwargs: dict) -> bytes:
+    """``draw(*args, **kwargs)`` rendered to PNG bytes (:func:`.paper_result.render_png`); what
+    the worker runs for each figure."""
+    from .paper_result import render_png
+
+    return render_png(draw(*args, **kwargs))
+
+
+def _worker_init() -> None:
+    """In the worker: Ctrl-C is the study's business (it stops the pool)."""
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+class FigureProcess:
+    """A one-worker spawned process pool drawing figures (see the module docstring).
+
+    Parameters
+    ----------
+    ready : callable, optional
+        ``ready() -> bool``: whether the worker may be started now (default: always). Asked at
+        each :meth:`submit` until it says yes.
+    """
+
+    def __init__(self, ready: Callable[[], bool] | None = None):
+        self._ready = ready
+        self._pool = None
+        self._failed = False
+
+    @property
+    def started(self) -> bool:
+        """Whether the worker process has been started."""
+        return self._pool is not None
+
+    def submit(self, draw: Callable, args: tuple, kwargs: dict):
+        """Hand ``draw(*args, **kwargs)`` to the worker.
+
+        Returns
+        -------
+        concurrent.futures.Future or None
+            The PNG bytes to come; None when the worker is not to be started yet (``ready()``
+            said no), could not be started, or has broken: the caller draws the figure itself.
+        """
+        if self._failed:
+            return None
+        if self._pool is None:
+            if self._ready is not None and not self._ready():
+                return None
+            return self._start_with(draw, args, kwargs)
+        try:
+            return self._pool.submit(draw_png, draw, args, kwargs)
+        except RuntimeError:  # a broken pool (BrokenProcessPool is a RuntimeError), or shut down
+            self._failed = True
+            return None
+
+    def _start_with(self, draw, args, kwargs):
+        """Create the pool and submit the first figure (which spawns the worker)."""
+        import multiprocessing
+        from concurrent.futures import ProcessPoolExecutor
+
+        from ..stiffness.fe.background import starting_quietly
+
+        try:
+            pool = ProcessPoolExecutor(max_workers=1,
+                                       mp_context=multiprocessing.get_context("spawn"),
+                                       initializer=_worker_init)
+            with starting_quietly():
+                future = pool.submit(draw_png, draw, args, kwargs)
+        except (OSError, RuntimeError):  # no process to be had: this one draws everything
+            self._failed = True
+            return None
+        self._pool = pool
+        return future
+
+    def close(self, cancel: bool = True) -> None:
+        """Stop the worker after the figure it is drawing (``cancel``: the queued ones are
+        dropped); it exits on its own, this process does not wait for it."""
+        pool, self._pool = self._pool, None
+        self._failed = True
+        if pool is not None:
+            pool.shutdown(wait=False, cancel_futures=cancel)

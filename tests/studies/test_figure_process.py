@@ -1,0 +1,165 @@
+"""Report figures drawn by a second process (issue 16.6, :mod:`geardyn.studies.figure_process`):
+the same PNG bytes as drawn here, through the figure cache; held until the process may start;
+whatever the process does not draw (not started, failed, broken, stopped) drawn here."""
+
+from __future__ import annotations
+
+import os
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+import pytest  # noqa: E402
+
+from geardyn.studies.figure_process import FigureProcess, figure_process_allowed  # noqa: E402
+from geardyn.studies.paper_result import FigureStore, RenderedFigure, render_png  # noqa: E402
+
+#: the figures this process drew (the worker's own list is another one, in another process)
+CALLS: list = []
+
+
+def draw(y, *, title="t"):
+    CALLS.append(title)
+    fig, ax = plt.subplots(figsize=(2.5, 2), layout="constrained")
+    ax.plot(np.asarray(y))
+    ax.set_title(title)
+    ax.set_xlabel("sample")
+    return fig
+
+
+def draw_or_fail(y, *, title="t"):
+    if title == "bad":
+        raise ValueError("cannot draw 'bad'")
+    return draw(y, title=title)
+
+
+def _expected(y, title):
+    png = render_png(draw(y, title=title))
+    CALLS.pop()
+    return png
+
+
+TITLES = [f"figure {i}" for i in range(8)]
+
+
+def test_the_process_draws_the_same_pngs_and_the_cache_keeps_them(tmp_path, monkeypatch):
+    monkeypatch.setenv("GEARDYN_CACHE_DIR", str(tmp_path / "cache"))
+    CALLS.clear()
+    y = np.sin(np.linspace(0.0, 6.0, 200))
+    ready = {"now": False}
+    store = FigureStore(FigureProcess(ready=lambda: ready["now"]))
+    store.cached("f0", draw, y, title=TITLES[0])
+    store.cached("f1", draw, y, title=TITLES[1])
+    assert not store.process.started                   # held while ready() says no
+    ready["now"] = True
+    for i, title in enumerate(TITLES[2:], start=2):
+        store.cached(f"f{i}", draw, y, title=title)    # the held two go first
+    assert store.process.started and CALLS == []
+    assert len(store) == len(TITLES)
+    store["f0"]                                        # waits for the process to draw it
+    store.finish()                                     # this process takes the unstarted ones
+    assert store.process is None
+    assert TITLES[0] not in CALLS
+    # whatever this process drew, it drew from the last figure back
+    assert CALLS == TITLES[len(TITLES) - len(CALLS):][::-1]
+    for i, title in enumerate(TITLES):
+        assert isinstance(store[f"f{i}"], RenderedFigure)
+        assert store[f"f{i}"].png == _expected(y, title), title
+    # collected into the figure cache: a store without a process draws none of them again
+    CALLS.clear()
+    again = FigureStore()
+    for i, title in enumerate(TITLES):
+        again.cached(f"f{i}", draw, y, title=title)
+        assert again[f"f{i}"].png == store[f"f{i}"].png
+    assert CALLS == []
+    assert len(list((tmp_path / "cache" / "figure").glob("*.png"))) == len(TITLES)
+
+
+def test_what_the_process_does_not_draw_is_drawn_here(tmp_path, monkeypatch):
+    """Never ready: all drawn here. A figure whose drawing fails there is drawn here and raises
+    here. A worker killed mid-run: the rest drawn here. Stopped with figures queued: those too.
+    ``cached_here`` never goes to the process."""
+    import multiprocessing
+
+    monkeypatch.setenv("GEARDYN_CACHE_DIR", str(tmp_path / "cache"))
+    y = np.cos(np.linspace(0.0, 3.0, 50))
+
+    CALLS.clear()
+    never = FigureStore(FigureProcess(ready=lambda: False))
+    for title in TITLES[:3]:
+        never.cached(title, draw, y, title=title)
+    never.cached_here("here", draw, y, title="here")
+    assert CALLS == ["here"]
+    assert [t for t in never] == [*TITLES[:3], "here"]
+    assert {k: v.png for k, v in never.items()} == {t: _expected(y, t)
+                                                    for t in [*TITLES[:3], "here"]}
+    assert CALLS == ["here", *reversed(TITLES[:3])]     # drawn here, from the last one back
+
+    monkeypatch.setenv("GEARDYN_NO_CACHE", "1")         # every figure goes to the process
+    CALLS.clear()
+    failing = FigureStore(FigureProcess())
+    failing.cached("bad", draw_or_fail, y, title="bad")
+    failing.cached("good", draw_or_fail, y, title="good")
+    with pytest.raises(ValueError, match="cannot draw 'bad'"):
+        failing["bad"]                                   # failed there, drawn (and failed) here
+    assert failing["good"].png == _expected(y, "good")
+
+    before = set(multiprocessing.active_children())
+    broken = FigureStore(FigureProcess())
+    broken.cached("a", draw, y, title="a")
+    broken["a"]                                          # drawn by the process
+    (worker,) = set(multiprocessing.active_children()) - before
+    worker.kill()
+    worker.join(timeout=30)
+    for title in ("b", "c"):
+        broken.cached(title, draw, y, title=title)
+    broken.finish()
+    assert [broken[t].png for t in "abc"] == [_expected(y, t) for t in "abc"]
+
+    stopped = FigureStore(FigureProcess())
+    for title in TITLES:
+        stopped.cached(title, draw, y, title=title)
+    stopped.close()                                      # e.g. Ctrl-C: the queue dropped
+    assert stopped.process is None
+    CALLS.clear()
+    stopped.finish()                                     # the dropped ones drawn here
+    assert CALLS == TITLES[len(TITLES) - len(CALLS):][::-1]
+    assert [stopped[t].png for t in TITLES] == [_expected(y, t) for t in TITLES]
+
+
+def test_who_may_have_a_figure_process(monkeypatch):
+    import multiprocessing
+
+    from geardyn.stiffness.fe.background import FE_PROCESSES_ENV
+    from geardyn.studies.paper import _figure_process
+    from geardyn.studies.paper_result import StudyResult
+
+    monkeypatch.setenv(FE_PROCESSES_ENV, "0")
+    assert not figure_process_allowed()
+    assert _figure_process(StudyResult(out=".")) is None
+    monkeypatch.setenv(FE_PROCESSES_ENV, "1")
+    assert figure_process_allowed()
+    result = StudyResult(out=".")
+    proc = _figure_process(result)
+    assert isinstance(proc, FigureProcess) and not proc.started
+
+    class Alive:
+        def is_alive(self):
+            return True
+
+    result.background.append(Alive())   # e.g. the FE bodies' process: not yet
+    assert proc.submit(draw, (np.arange(3.0),), {}) is None and not proc.started
+
+    class Daemon:
+        daemon = True
+
+    with monkeypatch.context() as m:
+        m.setattr(multiprocessing, "current_process", lambda: Daemon())
+        assert not figure_process_allowed()   # a pool's worker may not have children
+    monkeypatch.setenv(FE_PROCESSES_ENV, "2")
+    with pytest.raises(ValueError, match=FE_PROCESSES_ENV):
+        figure_process_allowed()
+    assert os.environ[FE_PROCESSES_ENV] == "2"
