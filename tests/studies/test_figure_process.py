@@ -36,6 +36,10 @@ def draw_or_fail(y, *, title="t"):
     return draw(y, title=title)
 
 
+def draw_mapped(y, f, *, title="t"):
+    return draw(f(np.asarray(y)), title=title)
+
+
 def _expected(y, title):
     png = render_png(draw(y, title=title))
     CALLS.pop()
@@ -80,8 +84,9 @@ def test_the_process_draws_the_same_pngs_and_the_cache_keeps_them(tmp_path, monk
 
 def test_what_the_process_does_not_draw_is_drawn_here(tmp_path, monkeypatch):
     """Never ready: all drawn here. A figure whose drawing fails there is drawn here and raises
-    here. A worker killed mid-run: the rest drawn here. Stopped with figures queued: those too.
-    ``cached_here`` never goes to the process."""
+    here. Arguments that do not pickle: drawn here, the figures after it still go. A worker
+    killed mid-run: the rest drawn here. Stopped with figures queued: those too. ``cached_here``
+    never goes to the process."""
     import multiprocessing
 
     monkeypatch.setenv("GEARDYN_CACHE_DIR", str(tmp_path / "cache"))
@@ -106,6 +111,16 @@ def test_what_the_process_does_not_draw_is_drawn_here(tmp_path, monkeypatch):
     with pytest.raises(ValueError, match="cannot draw 'bad'"):
         failing["bad"]                                   # failed there, drawn (and failed) here
     assert failing["good"].png == _expected(y, "good")
+
+    CALLS.clear()
+    unpicklable = FigureStore(FigureProcess())
+    unpicklable.cached("lambda", draw_mapped, y, lambda v: 2.0 * v, title="lambda")
+    unpicklable.cached("after it", draw, y, title="after it")
+    assert unpicklable["after it"].png == _expected(y, "after it")
+    assert CALLS == []                                   # not held up: drawn by the process
+    assert unpicklable["lambda"].png == render_png(draw(2.0 * y, title="lambda"))
+    assert CALLS == ["lambda", "lambda"]                 # the lambda's figure drawn here
+    unpicklable.finish()
 
     before = set(multiprocessing.active_children())
     broken = FigureStore(FigureProcess())

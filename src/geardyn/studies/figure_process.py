@@ -28,7 +28,12 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-__all__ = ["FigureProcess", "figure_process_allowed", "draw_png"]
+__all__ = ["FigureProcess", "NotPicklable", "figure_process_allowed", "draw_png"]
+
+
+class NotPicklable(TypeError):
+    """A figure's drawing function or arguments do not pickle (a lambda, an open file...): the
+    caller draws it itself."""
 
 
 def figure_process_allowed() -> bool:
@@ -53,6 +58,14 @@ def draw_png(draw: Callable, args: tuple, kwargs: dict) -> bytes:
     from .paper_result import render_png
 
     return render_png(draw(*args, **kwargs))
+
+
+def _draw_pickled(payload: bytes) -> bytes:
+    """In the worker: :func:`draw_png` of the pickled ``(draw, args, kwargs)``."""
+    import pickle
+
+    draw, args, kwargs = pickle.loads(payload)
+    return draw_png(draw, args, kwargs)
 
 
 def _worker_init() -> None:
@@ -89,21 +102,34 @@ class FigureProcess:
         -------
         concurrent.futures.Future or None
             The PNG bytes to come; None when the worker is not to be started yet (``ready()``
-            said no), could not be started, or has broken: the caller draws the figure itself.
+            said no), could not be started, or has broken: the caller draws the figure itself
+            (or hands it over again later).
+
+        Raises
+        ------
+        NotPicklable
+            ``draw`` or its arguments do not pickle (asked only when the process can take the
+            figure): the caller draws it itself.
         """
+        import pickle
+
         if self._failed:
             return None
+        if self._pool is None and self._ready is not None and not self._ready():
+            return None
+        try:  # pickled here and now: the figure shows the arguments as they are at this call
+            payload = pickle.dumps((draw, args, kwargs), protocol=pickle.HIGHEST_PROTOCOL)
+        except Exception as exc:  # noqa: BLE001 - whatever pickle raises for what it cannot take
+            raise NotPicklable(f"{type(exc).__name__}: {exc}") from exc
         if self._pool is None:
-            if self._ready is not None and not self._ready():
-                return None
-            return self._start_with(draw, args, kwargs)
+            return self._start_with(payload)
         try:
-            return self._pool.submit(draw_png, draw, args, kwargs)
+            return self._pool.submit(_draw_pickled, payload)
         except RuntimeError:  # a broken pool (BrokenProcessPool is a RuntimeError), or shut down
             self._failed = True
             return None
 
-    def _start_with(self, draw, args, kwargs):
+    def _start_with(self, payload: bytes):
         """Create the pool and submit the first figure (which spawns the worker)."""
         import multiprocessing
         from concurrent.futures import ProcessPoolExecutor
@@ -115,7 +141,7 @@ class FigureProcess:
                                        mp_context=multiprocessing.get_context("spawn"),
                                        initializer=_worker_init)
             with starting_quietly():
-                future = pool.submit(draw_png, draw, args, kwargs)
+                future = pool.submit(_draw_pickled, payload)
         except (OSError, RuntimeError):  # no process to be had: this one draws everything
             self._failed = True
             return None

@@ -278,15 +278,23 @@ class _Pending:
     as the process has drawn the figure (they are only needed to draw it here instead), so the
     records and diagnoses a figure shows are not held until the report collects it."""
 
-    __slots__ = ("digest", "draw", "args", "kwargs", "future")
+    __slots__ = ("digest", "draw", "args", "kwargs", "future", "here")
 
     def __init__(self, digest: str | None, draw: Callable, args: tuple, kwargs: dict):
         self.digest, self.draw, self.args, self.kwargs = digest, draw, args, kwargs
         self.future = None
+        self.here = False  # True: its arguments do not pickle, this process draws it
 
     def send(self, process) -> bool:
-        """Hand the figure to ``process``; False if it does not take it now."""
-        self.future = process.submit(self.draw, self.args, self.kwargs)
+        """Hand the figure to ``process``; False if the process does not take it now. A figure
+        whose arguments do not pickle is marked to be drawn here (and counts as handed over)."""
+        from .figure_process import NotPicklable
+
+        try:
+            self.future = process.submit(self.draw, self.args, self.kwargs)
+        except NotPicklable:
+            self.here = True
+            return True
         if self.future is None:
             return False
         self.future.add_done_callback(self._drawn)
@@ -343,7 +351,7 @@ class FigureStore(dict):
             return
         for key in self._pending():
             job = super().__getitem__(key)
-            if job.future is None and not job.send(self.process):
+            if job.future is None and not job.here and not job.send(self.process):
                 return
 
     def _collect(self, key, job: _Pending) -> RenderedFigure:

@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...errors import InputError, NumericalError
-from .mesh import _GMSH_LOCK
+from .mesh import _GMSH_LOCK, _initialize_gmsh
 from .solve import ElasticMaterial
 
 __all__ = ["CrackedMesh", "mesh_cracked_polygon", "split_crack", "edge_crack_strip",
@@ -155,7 +155,7 @@ def mesh_cracked_polygon(outline: np.ndarray, crack: np.ndarray, *, tip_size: fl
                              "vertex of the outline")
     tip_pts = [crack[-1]] if edge_crack else [crack[0], crack[-1]]
     with _GMSH_LOCK:
-        gmsh.initialize(["", "-nt", "1"], readConfigFiles=False, interruptible=False)
+        _initialize_gmsh()
         try:
             gmsh.option.setNumber("General.Terminal", 0)
             gmsh.option.setNumber("General.Verbosity", 1)

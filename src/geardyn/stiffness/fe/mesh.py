@@ -55,6 +55,45 @@ __all__ = ["MeshSettings", "CrackGeometry", "BodyMesh", "build_body_mesh", "load
 _GMSH_LOCK = threading.Lock()
 
 
+def _initialize_gmsh() -> None:
+    """``gmsh.initialize`` for one mesh (one thread, no configuration files, Ctrl-C left to
+    Python), with Python's ``SIGPIPE`` disposition put back afterwards.
+
+    gmsh's initialisation sets ``SIGPIPE`` to its default action (measured with gmsh 4.15.2:
+    ``sigaction`` reports ``SIG_IGN`` before ``gmsh.initialize`` and ``SIG_DFL`` after it, also
+    after ``gmsh.finalize``; no other signal changes), while Python ignores it "so write errors
+    on pipes and sockets can be reported as ordinary Python exceptions" (Python's ``signal``
+    module documentation, *General rules*). After a mesh, a write to a closed pipe killed the
+    whole process without a word: ``geardyn stiffness ... | head -1``, or the queue feeding a
+    second process that has died (``geardyn.studies.figure_process``). Call it holding
+    :data:`_GMSH_LOCK`.
+    """
+    import signal
+
+    import gmsh
+
+    gmsh.initialize(["", "-nt", "1"], readConfigFiles=False, interruptible=False)
+    if hasattr(signal, "SIGPIPE") and signal.getsignal(signal.SIGPIPE) == signal.SIG_IGN:
+        _ignore_sigpipe()
+
+
+def _ignore_sigpipe() -> None:
+    """Set ``SIGPIPE`` to ``SIG_IGN`` for the process: through :func:`signal.signal` in the
+    main thread, through the C library's ``signal`` in another (where Python refuses)."""
+    import signal
+    import threading
+
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGPIPE, signal.SIG_IGN)
+        return
+    import ctypes
+
+    libc = ctypes.CDLL(None, use_errno=True)
+    libc.signal.argtypes = [ctypes.c_int, ctypes.c_void_p]
+    libc.signal.restype = ctypes.c_void_p
+    libc.signal(int(signal.SIGPIPE), 1)  # 1: SIG_IGN in every C library with SIGPIPE
+
+
 @dataclass(frozen=True)
 class MeshSettings:
     """Element sizes of a body mesh [m] and how many teeth are refined.
@@ -390,7 +429,7 @@ def _build_body_mesh(gear: Gear, settings: MeshSettings, crack: CrackGeometry | 
 
     # gmsh is a process-wide singleton and not thread-safe: one mesh at a time per process
     with _GMSH_LOCK:
-        gmsh.initialize(["", "-nt", "1"], readConfigFiles=False, interruptible=False)
+        _initialize_gmsh()
         try:
             gmsh.option.setNumber("General.Terminal", 0)
             gmsh.option.setNumber("General.Verbosity", 1)

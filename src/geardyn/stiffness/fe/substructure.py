@@ -49,6 +49,7 @@ from .mesh import (
     BodyMesh,
     CrackGeometry,
     MeshSettings,
+    _initialize_gmsh,
     _orient_by_radius,
     _rot,
     check_cut,
@@ -122,7 +123,7 @@ def build_part_mesh(gear: Gear, settings: MeshSettings, part: str, *,
     n_arc = max(2, int(math.ceil(r_g * 2 * math.pi / z / h_g))) + 1
 
     with _GMSH_LOCK:
-        gmsh.initialize(["", "-nt", "1"], readConfigFiles=False, interruptible=False)
+        _initialize_gmsh()
         try:
             gmsh.option.setNumber("General.Terminal", 0)
             gmsh.option.setNumber("General.Verbosity", 1)
