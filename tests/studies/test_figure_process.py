@@ -15,7 +15,12 @@ import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 
 from geardyn.studies.figure_process import FigureProcess, figure_process_allowed  # noqa: E402
-from geardyn.studies.paper_result import FigureStore, RenderedFigure, render_png  # noqa: E402
+from geardyn.studies.paper_result import (  # noqa: E402
+    IN_FLIGHT,
+    FigureStore,
+    RenderedFigure,
+    render_png,
+)
 
 #: the figures this process drew (the worker's own list is another one, in another process)
 CALLS: list = []
@@ -63,6 +68,7 @@ def test_the_process_draws_the_same_pngs_and_the_cache_keeps_them(tmp_path, monk
         store.cached(f"f{i}", draw, y, title=title)    # the held two go first
     assert store.process.started and CALLS == []
     assert len(store) == len(TITLES)
+    assert store._in_flight <= IN_FLIGHT               # the rest wait as they are, not pickled
     store["f0"]                                        # waits for the process to draw it
     store.finish()                                     # this process takes the unstarted ones
     assert store.process is None
@@ -140,8 +146,10 @@ def test_what_the_process_does_not_draw_is_drawn_here(tmp_path, monkeypatch):
     stopped.close()                                      # e.g. Ctrl-C: the queue dropped
     assert stopped.process is None
     CALLS.clear()
-    stopped.finish()                                     # the dropped ones drawn here
-    assert CALLS == TITLES[len(TITLES) - len(CALLS):][::-1]
+    stopped.finish()                                     # the held ones drawn here, last first
+    held = TITLES[IN_FLIGHT:]
+    assert CALLS[:len(held)] == held[::-1]
+    assert set(CALLS[len(held):]) <= set(TITLES[:IN_FLIGHT])   # the sent ones, if dropped
     assert [stopped[t].png for t in TITLES] == [_expected(y, t) for t in TITLES]
 
 

@@ -273,7 +273,7 @@ def render_png(fig) -> bytes:
 
 
 class _Pending:
-    """A figure handed to the figure process (or held for it): its cache key, how to draw it
+    """A figure handed to the figure process, or held for it: its cache key, how to draw it
     here, and the PNG to come (``future``, None while held). The arguments are let go as soon
     as the process has drawn the figure (they are only needed to draw it here instead), so the
     records and diagnoses a figure shows are not held until the report collects it."""
@@ -285,24 +285,12 @@ class _Pending:
         self.future = None
         self.here = False  # True: its arguments do not pickle, this process draws it
 
-    def send(self, process) -> bool:
-        """Hand the figure to ``process``; False if the process does not take it now. A figure
-        whose arguments do not pickle is marked to be drawn here (and counts as handed over)."""
-        from .figure_process import NotPicklable
 
-        try:
-            self.future = process.submit(self.draw, self.args, self.kwargs)
-        except NotPicklable:
-            self.here = True
-            return True
-        if self.future is None:
-            return False
-        self.future.add_done_callback(self._drawn)
-        return True
-
-    def _drawn(self, future) -> None:
-        if not future.cancelled() and future.exception() is None:
-            self.args, self.kwargs = (), {}
+#: Figures at most in the figure process's hands at once (sent, not drawn yet): each is a
+#: pickled copy of its arguments in this process until drawn; the others wait as they are. With
+#: no bound, a full run's records pickled for eight figures at once raised this process's peak
+#: by about 250 MB (measured 2026-11-26).
+IN_FLIGHT = 2
 
 
 class FigureStore(dict):
@@ -312,13 +300,21 @@ class FigureStore(dict):
     figures and their data).
 
     With a :class:`~.figure_process.FigureProcess` (``process``), :meth:`cached` hands the
-    figures it has to draw to that second process and returns at once; reading a figure
-    (``store[name]``, ``get``, ``items``, ``values``) or :meth:`finish` collects them.
+    figures it has to draw to that second process and returns at once: at most
+    :data:`IN_FLIGHT` at a time, the next one sent as one is drawn, in the order they came.
+    Reading a figure (``store[name]``, ``get``, ``items``, ``values``) or :meth:`finish`
+    collects them.
     """
 
     def __init__(self, process=None):
+        import threading
+        from collections import deque
+
         super().__init__()
         self.process = process
+        self._held: deque = deque()    # handed over, not sent yet, in order
+        self._in_flight = 0
+        self._lock = threading.RLock()  # _held, _in_flight: this thread and the pool's callbacks
 
     def __setitem__(self, key, fig) -> None:
         if not isinstance(fig, (RenderedFigure, _Pending)) and hasattr(fig, "savefig"):
@@ -345,18 +341,42 @@ class FigureStore(dict):
     def _pending(self) -> list:
         return [k for k, v in super().items() if isinstance(v, _Pending)]
 
-    def _send_held(self) -> None:
-        """Hand the held figures, in order, to the process if it takes them now."""
-        if self.process is None:
-            return
-        for key in self._pending():
-            job = super().__getitem__(key)
-            if job.future is None and not job.here and not job.send(self.process):
-                return
+    def _pump(self) -> None:
+        """Send held figures, first come first, while fewer than :data:`IN_FLIGHT` are in the
+        process's hands (from this thread, and from the pool's thread as each is drawn)."""
+        from .figure_process import NotPicklable
+
+        with self._lock:
+            while self.process is not None and self._held and self._in_flight < IN_FLIGHT:
+                job = self._held[0]
+                try:
+                    future = self.process.submit(job.draw, job.args, job.kwargs)
+                except NotPicklable:
+                    self._held.popleft()
+                    job.here = True
+                    continue
+                if future is None:  # not yet (or never): they stay held
+                    return
+                self._held.popleft()
+                job.future = future
+                self._in_flight += 1
+                future.add_done_callback(lambda f, job=job: self._drawn(job, f))
+
+    def _drawn(self, job: _Pending, future) -> None:
+        """The process is done with ``job`` (called from the pool's thread)."""
+        if not future.cancelled() and future.exception() is None:
+            job.args, job.kwargs = (), {}
+        with self._lock:
+            self._in_flight -= 1
+        self._pump()
 
     def _collect(self, key, job: _Pending) -> RenderedFigure:
         """The figure of ``job``: the process's PNG, or drawn here when the process did not
-        draw it (held, cancelled, failed); stored in the figure cache."""
+        draw it (held, arguments not picklable, cancelled, failed); stored in the figure
+        cache."""
+        with self._lock:
+            if job.future is None and job in self._held:
+                self._held.remove(job)  # drawn here, never sent
         png = None
         if job.future is not None and not job.future.cancelled():
             try:
@@ -377,18 +397,20 @@ class FigureStore(dict):
         return figure
 
     def finish(self) -> None:
-        """Collect every figure handed to the process: this process draws, from the last one
-        back, each the process has not started, while the process goes on from the first; then
-        the process is stopped. Cheap when nothing is pending."""
+        """Collect every figure handed to the process: this process draws those not sent yet,
+        from the last one back, while the process goes on from the first; then the process is
+        stopped. Cheap when nothing is pending."""
         pending = self._pending()
         if not pending:
             return
-        self._send_held()
-        for key in reversed(pending):
-            job = super().__getitem__(key)
-            if job.future is None or job.future.cancel():
-                job.future = None
-                self._collect(key, job)
+        self._pump()
+        keys = {id(v): k for k, v in super().items() if isinstance(v, _Pending)}
+        while True:
+            with self._lock:
+                job = self._held.pop() if self._held else None
+            if job is None:
+                break
+            self._collect(keys[id(job)], job)
         for key in pending:
             job = super().__getitem__(key)
             if isinstance(job, _Pending):
@@ -456,9 +478,10 @@ class FigureStore(dict):
 
     def _hand_over(self, key, digest: str | None, draw: Callable, args: tuple,
                    kwargs: dict) -> None:
-        """Hand ``draw(*args, **kwargs)`` to the figure process (held until it starts), after
-        the figures held before it; ``digest``: its figure-cache key (None: not cached)."""
-        self._send_held()
+        """Hand ``draw(*args, **kwargs)`` to the figure process, after the figures handed over
+        before it (:meth:`_pump`); ``digest``: its figure-cache key (None: not cached)."""
         job = _Pending(digest, draw, args, kwargs)
-        job.send(self.process)
         super().__setitem__(key, job)
+        with self._lock:
+            self._held.append(job)
+        self._pump()
