@@ -111,3 +111,19 @@ def test_python_warnings_are_one_clean_line(tmp_path):
     assert any("revolution" in ln for ln in warn), r.stderr
     assert ".py:" not in r.stderr and "warnings.warn" not in r.stderr
     assert all(len(ln) < 500 for ln in warn)
+
+
+@pytest.mark.parametrize("value", ["2", "yes"])
+def test_a_bad_second_process_setting_is_a_user_error_before_any_output(tmp_path, value):
+    """``GEARDYN_FE_PROCESSES`` (read by every ``geardyn run`` since the figures may use a
+    second process): a bad value exits 2 with one line naming it, before the folder exists."""
+    out = tmp_path / "out"
+    r = run_geardyn(["run", "--quick", "--stiffness", "pem", "--out", str(out)],
+                    capture_output=True, text=True, timeout=300,
+                    env={**os.environ, "GEARDYN_FE_PROCESSES": value,
+                         "GEARDYN_CACHE_DIR": str(tmp_path / "cache")})
+    assert r.returncode == 2, r.stderr
+    assert "GEARDYN_FE_PROCESSES" in r.stderr and repr(value) in r.stderr
+    assert "Traceback" not in r.stderr and "internal error" not in r.stderr
+    assert len(r.stderr.strip().splitlines()) == 1, r.stderr
+    assert not out.exists()

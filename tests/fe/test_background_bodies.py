@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 import geardyn
+from geardyn import processes
 from geardyn.cache import Cache, record_lookups
 from geardyn.stiffness import build_map
 from geardyn.stiffness.fe import background as bg
@@ -173,7 +174,7 @@ def test_the_default_needs_two_cores_and_the_memory(monkeypatch):
     for cores, avail, expected in [(2, big, 1), (1, big, 0), (None, big, 0), (2, small, 0),
                                    (16, bg.MIN_AVAILABLE_BYTES, 1), (2, None, 1)]:
         monkeypatch.setattr(os, "cpu_count", lambda c=cores: c)
-        monkeypatch.setattr(bg, "_available_memory", lambda a=avail: a)
+        monkeypatch.setattr(processes, "_available_memory", lambda a=avail: a)
         assert fe_processes() == expected, (cores, avail)
 
 

@@ -83,6 +83,9 @@ def run(
     from ..studies.paper import STAGES, run_paper_study
 
     check_bounded_work(_simulation_case(case, quick))
+    from ..processes import fe_processes
+
+    fe_processes()  # a bad GEARDYN_FE_PROCESSES refused before the output folder is claimed
     state = claim_folder(target, ident, force=force, results=RESULTS)
     say_state(state, target)
     with progress_bar() as bar, record_lookups() as lookups:

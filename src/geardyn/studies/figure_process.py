@@ -17,7 +17,7 @@ this process, which raises the error, if any, with its own traceback.
 
 It costs memory: a second interpreter with matplotlib, xarray and geardyn imported (about
 150-200 MB). It is used where the FE bodies' second process would be
-(:func:`geardyn.stiffness.fe.background.fe_processes`: ``GEARDYN_FE_PROCESSES=0`` runs
+(:func:`geardyn.processes.fe_processes`: ``GEARDYN_FE_PROCESSES=0`` runs
 everything in one process), not from a daemon process (a pool's worker may not have children),
 and it starts only when ``ready()`` says so: the study waits until its other background
 processes (the FE bodies, the kernel compiler) have ended, so that no more than two processes
@@ -38,16 +38,16 @@ class NotPicklable(TypeError):
 
 def figure_process_allowed() -> bool:
     """Whether a second process may draw figures: as for the FE bodies' second process
-    (:func:`geardyn.stiffness.fe.background.fe_processes`), and not from a daemon process.
+    (:func:`geardyn.processes.fe_processes`), and not from a daemon process.
 
     Raises
     ------
-    ValueError
+    geardyn.errors.InputError
         ``GEARDYN_FE_PROCESSES`` set to anything but 0 or 1.
     """
     import multiprocessing
 
-    from ..stiffness.fe.background import fe_processes
+    from ..processes import fe_processes
 
     return fe_processes() == 1 and not multiprocessing.current_process().daemon
 
@@ -134,7 +134,7 @@ class FigureProcess:
         import multiprocessing
         from concurrent.futures import ProcessPoolExecutor
 
-        from ..stiffness.fe.background import starting_quietly
+        from ..processes import starting_quietly
 
         try:
             pool = ProcessPoolExecutor(max_workers=1,

@@ -214,7 +214,7 @@ def stiffness_stage(case: Case, out: Path, result: StudyResult) -> None:
         # which would mesh the body again)
         result.summary["fe_mesh_refinement"] = float(map_case.stiffness.fe.refinement)
         result.figures.cached_here("fig_fe_mesh", plot_mesh, map_case,
-                              cracked=case.crack is not None and case.crack.active)
+                                   cracked=case.crack is not None and case.crack.active)
     cracks = case.crack is not None and case.crack.active
     dd_op = result.summary.get("static", {}).get("centre_distance_change_mm", 0.0) * 1e-3
     dd_op = dd_op if cracked.covers(dd_op) else 0.0
