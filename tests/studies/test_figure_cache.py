@@ -57,10 +57,11 @@ def test_without_cache_or_fingerprint_the_figure_is_drawn(tmp_path, monkeypatch)
     assert not (tmp_path / "cache" / "figure").exists()
 
 
-def test_a_constrained_layout_figure_is_saved_without_a_second_tight_drawing():
-    """png_bbox: a figure with a layout engine (every report figure) fits its canvas already, so
-    it is saved as it is; one without is cropped to its content. The constrained figure's PNG
-    is the canvas at FIGURE_DPI, its labels inside it."""
+def test_a_title_wider_than_its_axes_is_saved_whole():
+    """A constrained-layout figure (every report figure) whose right-hand title is wider than
+    its axes, as the demodulation figures' are: the PNG holds the whole title (the tight box
+    grows past the canvas) and nothing touches its outermost pixels. Saved as the canvas, the
+    title's end was cut off."""
     import io
 
     from matplotlib.figure import Figure
@@ -69,19 +70,17 @@ def test_a_constrained_layout_figure_is_saved_without_a_second_tight_drawing():
     from geardyn.studies.paper_result import FIGURE_DPI
     from geardyn.studies.report import png_bbox
 
-    fig = Figure(figsize=(3.0, 2.0), layout="constrained")
-    ax = fig.subplots()
-    ax.plot([0.0, 1.0], [0.0, 1e6])
-    ax.set_xlabel("a long label on the x axis [m]")
-    ax.set_ylabel("y [N]")
-    assert png_bbox(fig) is None
-    assert png_bbox(Figure(figsize=(3.0, 2.0))) == "tight"
-    assert png_bbox(RenderedFigure(b"")) == "tight"
+    fig = Figure(figsize=(4.0, 2.0), layout="constrained")
+    axs = fig.subplots(1, 2)
+    for ax in axs:
+        ax.plot([0.0, 1.0], [0.0, 1e6])
+        ax.set_xlabel("a label on the x axis [m]")
+    axs[1].set_title("model II: a title much longer than its axes (kurtosis 15.07)")
+    assert png_bbox(fig) == "tight"
     s = FigureStore()
     s["f"] = fig
     img = np.asarray(Image.open(io.BytesIO(s["f"].png)).convert("L"))
-    assert img.shape == (2.0 * FIGURE_DPI, 3.0 * FIGURE_DPI)
-    # nothing drawn on the outermost pixel rows and columns: the layout kept the labels inside
+    assert img.shape[1] > 4.0 * FIGURE_DPI           # wider than the canvas: the title's end
     assert img[[0, -1], :].min() == 255 and img[:, [0, -1]].min() == 255
     # ... and the labels are there: dark pixels near the bottom edge (the x label)
     assert img[-int(0.15 * FIGURE_DPI):, :].min() < 128

@@ -70,15 +70,17 @@ def _slug(text: str) -> str:
     return re.sub(r"[^a-z0-9]+", "-", text.lower()).strip("-")[:60] or "section"
 
 
-def png_bbox(fig) -> str | None:
-    """``bbox_inches`` for saving ``fig``: ``"tight"`` only for a figure without a layout
-    engine. A constrained-layout figure (every figure of the report) already fits its content
-    to the canvas, and a tight bounding box draws it a second time to measure it: 10-20 % of
-    each figure's saving time (22 figures of ``geardyn run --quick``: 6.9 s tight, 5.9 s
-    without, 2026-11-26)."""
-    engine = getattr(fig, "get_layout_engine", None)  # (a RenderedFigure has none: ignored)
-    return None if engine is not None and engine() is not None else "tight"
+def png_bbox(fig) -> str:
+    """``bbox_inches`` for saving ``fig``: ``"tight"``, for every figure.
 
+    A constrained-layout figure fits its axes, labels and the height of its titles to the
+    canvas, but not a title wider than its axes: saved as it is, the report's Fig. 16 analogue
+    lost the end of its right-hand title ("kurtosis 15.07" cut at the canvas edge; seen
+    2026-11-26 in a spall case's report). The tight box draws the figure a second time to
+    measure it (10-20 % of its saving time, 22 figures of ``geardyn run --quick``: 6.9 s tight,
+    5.9 s without, measured 2026-11-26, most of it now in the figure process) and keeps
+    everything drawn."""
+    return "tight"
 
 
 @dataclass
