@@ -273,15 +273,16 @@ def render_png(fig) -> bytes:
 
 
 class _Pending:
-    """A figure handed to the figure process, or held for it: its cache key, how to draw it
-    here, and the PNG to come (``future``, None while held). The arguments are let go as soon
-    as the process has drawn the figure (they are only needed to draw it here instead), so the
-    records and diagnoses a figure shows are not held until the report collects it."""
+    """A figure handed to the figure process, or held for it: its name and cache key, how to
+    draw it here, and the PNG to come (``future``, None while held). The arguments are let go
+    as soon as the process has drawn the figure (they are only needed to draw it here instead),
+    so the records and diagnoses a figure shows are not held until the report collects it."""
 
-    __slots__ = ("digest", "draw", "args", "kwargs", "future", "here")
+    __slots__ = ("key", "digest", "draw", "args", "kwargs", "future", "here")
 
-    def __init__(self, digest: str | None, draw: Callable, args: tuple, kwargs: dict):
-        self.digest, self.draw, self.args, self.kwargs = digest, draw, args, kwargs
+    def __init__(self, key, digest: str | None, draw: Callable, args: tuple, kwargs: dict):
+        self.key, self.digest = key, digest
+        self.draw, self.args, self.kwargs = draw, args, kwargs
         self.future = None
         self.here = False  # True: its arguments do not pickle, this process draws it
 
@@ -404,13 +405,12 @@ class FigureStore(dict):
         if not pending:
             return
         self._pump()
-        keys = {id(v): k for k, v in super().items() if isinstance(v, _Pending)}
         while True:
             with self._lock:
                 job = self._held.pop() if self._held else None
             if job is None:
                 break
-            self._collect(keys[id(job)], job)
+            self._collect(job.key, job)
         for key in pending:
             job = super().__getitem__(key)
             if isinstance(job, _Pending):
@@ -480,7 +480,7 @@ class FigureStore(dict):
                    kwargs: dict) -> None:
         """Hand ``draw(*args, **kwargs)`` to the figure process, after the figures handed over
         before it (:meth:`_pump`); ``digest``: its figure-cache key (None: not cached)."""
-        job = _Pending(digest, draw, args, kwargs)
+        job = _Pending(key, digest, draw, args, kwargs)
         super().__setitem__(key, job)
         with self._lock:
             self._held.append(job)
