@@ -465,6 +465,19 @@ def _write_run_file(ds, path: Path) -> None:
                  {"float32": RUN_ENCODING_FLOAT32, "compression": COMPRESSION}, write)
 
 
+#: The record variables the dynamics figures read (besides ``time``): Fig. 8's design
+#: parameters and crack events, Fig. 9's iteration residuals (the start-of-step record).
+FIG8_VARIABLES = ("centre_distance_change", "pressure_angle", "contact_ratio",
+                  "contact_ratio_eq8", "theta_p")
+FIG9_VARIABLES = ("residual_before", "residual_after", "iterations", "mesh_stiffness", "theta_p")
+
+
+def _variables(ds, names: tuple[str, ...]):
+    """``ds`` with only the data variables ``names`` (and its coordinates): the same arrays,
+    not copies, so the others go when ``ds`` does."""
+    return ds[list(names)]
+
+
 #: Longest wait [s] for a second process compiling the time-step kernel (it takes 5-10 s on a
 #: 2-core machine); after it, this process compiles the kernel itself.
 KERNEL_COMPILE_WAIT_S = 60.0
@@ -535,17 +548,23 @@ def simulation_stage(case: Case, out: Path, result: StudyResult) -> None:
     half = 0.55 * rev
     w8 = (max(t[0], tc - half), min(t[-1], tc + half))
     faulty, fault = faulty_words(case)
-    result.figures.cached("fig8_design_parameters", pf.fig8_design_parameters, ds2, ca, w8,
-                          fault=fault)
+    # each figure gets only the variables it draws (a figure queued for the figure process
+    # holds its arguments until drawn: a full run's record is 24 variables, 19 MB)
+    result.figures.cached("fig8_design_parameters", pf.fig8_design_parameters,
+                          _variables(ds2, FIG8_VARIABLES), ca, w8, fault=fault)
     ds_s = runs[("II-start", "cracked")]
     ts = ds_s["time"].values
     tcs_s = pf.crack_times(ds_s, ca) if ca is not None else np.array([])
     tc_s = float(tcs_s[0]) if tcs_s.size else float(ts[0] + 0.5 * (ts[-1] - ts[0]))
     w9 = (max(ts[0], tc_s - 0.012), min(ts[-1], tc_s + 0.012))
-    result.figures.cached("fig9_iteration", pf.fig9_iteration, ds_s, ds2, ca, w9,
-                          case.simulation.tolerance)
-    result.figures.cached("fig10_stiffness", pf.fig10_stiffness, runs[("I", "cracked")], ds2, ca,
-                          w8, ds_i_static=runs[("I-static", "cracked")])
+    result.figures.cached("fig9_iteration", pf.fig9_iteration,
+                          _variables(ds_s, FIG9_VARIABLES), _variables(ds2, ("residual_before",)),
+                          ca, w9, case.simulation.tolerance)
+    result.figures.cached("fig10_stiffness", pf.fig10_stiffness,
+                          _variables(runs[("I", "cracked")], ("mesh_stiffness",)),
+                          _variables(ds2, ("mesh_stiffness", "theta_p")), ca, w8,
+                          ds_i_static=_variables(runs[("I-static", "cracked")],
+                                                 ("mesh_stiffness",)))
     result.summary["model_comparison"] = model_comparison(runs)
     if result.summary["model_comparison"]:
         result.figures.cached("fig_model_comparison", pf.fig_model_comparison,
