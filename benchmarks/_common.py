@@ -8,9 +8,14 @@ target is met on this machine.
 
 from __future__ import annotations
 
+import re
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
+
+#: A target the table can measure a margin against: a comparison, a number and the row's unit
+#: (``"< 15 s"``, ``">= 1e7 lookups/s"``; words after the unit are allowed: ``"< 15 s (issue 16)"``).
+_TARGET = re.compile(r"^\s*(<=|<|>=|>)\s*([0-9][0-9.,]*(?:e[+-]?[0-9]+)?)\s*(\S+)")
 
 
 @dataclass(frozen=True)
@@ -42,6 +47,17 @@ class Row:
     baseline_value: float | None = None
     target: str = ""
     met: bool | None = None
+
+    @property
+    def margin(self) -> str:
+        """How far the measured figure is inside (``"by 0.4 s"``) or outside (``"by 3.7 s"``,
+        with ``met`` False) its target, in the row's unit; empty when the target is not a plain
+        comparison in that unit (``"<= 1.5x the C step"``, ``">= 80 %"`` of another figure)."""
+        m = _TARGET.match(self.target)
+        if m is None or m.group(3) != self.unit or self.value != self.value:  # (NaN: skipped)
+            return ""
+        limit = float(m.group(2).replace(",", ""))
+        return f"by {abs(self.value - limit):.3g} {self.unit}"
 
     @property
     def ratio(self) -> float | None:

@@ -60,6 +60,8 @@ def main(argv: list[str] | None = None) -> int:
             base = "" if r.baseline_value is None else f"{r.baseline}: {r.baseline_value:.4g} {r.unit}"
             ratio = "" if r.ratio is None else f"{r.ratio:.3g}x"
             met = "" if r.met is None else ("yes" if r.met else "NO")
+            if met and r.margin:  # by how much it is met or missed (issue 16, "must show")
+                met = f"{met}, {r.margin}"
             table.add_row(r.name, f"{r.value:.4g} {r.unit}", base, ratio, r.target, met)
     console.print(table)
     return 1 if failed else 0
