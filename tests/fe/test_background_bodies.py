@@ -165,7 +165,19 @@ def test_a_bad_setting_names_the_variable_its_value_and_what_is_allowed(monkeypa
     with pytest.raises(ValueError) as info:
         fe_processes()
     assert FE_PROCESSES_ENV in str(info.value) and repr(value) in str(info.value)
-    assert "0 (" in str(info.value) and "1 (" in str(info.value)
+    # what is allowed, in words (mutation testing, 2026-11-26: the text was not checked)
+    assert "0 (everything in one process) or 1 (a second process builds the faulty FE map's " \
+        "bodies, and one draws the report's figures)" in str(info.value)
+
+
+@pytest.mark.parametrize("value", ["", "  "])
+def test_an_empty_setting_is_the_default(monkeypatch, value):
+    """``GEARDYN_FE_PROCESSES=`` (set, but to nothing) is the default, not a bad value."""
+    monkeypatch.setenv(FE_PROCESSES_ENV, value)
+    monkeypatch.setattr(processes, "_available_memory", lambda: 8 * 1024 ** 3)
+    for cores, expected in [(2, 1), (1, 0)]:
+        monkeypatch.setattr(os, "cpu_count", lambda c=cores: c)
+        assert fe_processes() == expected
 
 
 def test_the_default_needs_two_cores_and_the_memory(monkeypatch):
@@ -184,6 +196,30 @@ def test_available_memory_is_read_from_meminfo():
         assert avail is None
     else:
         assert avail is not None and 0 < avail < 1 << 50
+
+
+def test_available_memory_is_meminfos_kib_in_bytes(monkeypatch):
+    """``MemAvailable`` is in KiB (proc(5)): the function answers bytes; a file without the
+    line, or an unreadable one, answers None (the default then does not depend on memory)."""
+    import builtins
+    import io
+
+    real_open = builtins.open
+    text = {"now": "MemTotal:       24000000 kB\nMemAvailable:    3145728 kB\nCached: 1 kB\n"}
+
+    def fake_open(path, *args, **kwargs):
+        if path == "/proc/meminfo":
+            if text["now"] is None:
+                raise PermissionError(path)
+            return io.StringIO(text["now"])
+        return real_open(path, *args, **kwargs)
+
+    monkeypatch.setattr(builtins, "open", fake_open)
+    assert processes._available_memory() == 3145728 * 1024 == processes.MIN_AVAILABLE_BYTES
+    text["now"] = "MemTotal:       24000000 kB\n"
+    assert processes._available_memory() is None
+    text["now"] = None
+    assert processes._available_memory() is None
 
 
 @pytest.mark.slow

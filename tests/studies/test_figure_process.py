@@ -186,3 +186,98 @@ def test_who_may_have_a_figure_process(monkeypatch):
     with pytest.raises(ValueError, match=FE_PROCESSES_ENV):
         figure_process_allowed()
     assert os.environ[FE_PROCESSES_ENV] == "2"
+
+
+def draw_sigint_state():
+    """A figure titled by how the process that draws it treats Ctrl-C."""
+    import signal
+
+    ignored = signal.getsignal(signal.SIGINT) == signal.SIG_IGN
+    return draw([0.0, 1.0], title="SIGINT ignored" if ignored else "SIGINT not ignored")
+
+
+def draw_slowly(seconds, *, title="slow"):
+    import time
+
+    time.sleep(seconds)
+    return draw([0.0, 1.0], title=title)
+
+
+def test_one_spawned_worker_that_ignores_ctrl_c_and_close_does_not_wait():
+    """Mutation testing (2026-11-26) found these unchecked: the pool has one worker, spawned
+    (not forked from a process with threads), which ignores Ctrl-C even when the pool was
+    started outside the main thread (where the parent cannot ignore it while starting);
+    ``close()`` neither waits for the figure being drawn nor lets the queued ones run, and a
+    closed process starts no new worker."""
+    import threading
+    import time
+
+    proc = FigureProcess()
+    box = {}
+    starter = threading.Thread(target=lambda: box.update(
+        first=proc.submit(draw_sigint_state, (), {})))
+    starter.start()
+    starter.join()
+    assert box["first"].result(timeout=120) == _expected([0.0, 1.0], "SIGINT ignored")
+    assert proc._pool._max_workers == 1
+    assert proc._pool._mp_context.get_start_method() == "spawn"
+    t0 = time.monotonic()
+    while box["first"] in proc._futures:   # a drawn figure's PNG is not kept here
+        assert time.monotonic() - t0 < 5.0
+        time.sleep(0.01)
+
+    slow = proc.submit(draw_slowly, (8.0,), {})
+    # the pool hands one more call to the worker's queue at once (marked running); the one
+    # after it waits in the pool (pending): that one close() drops
+    proc.submit(draw, ([1.0, 2.0],), {"title": "in the worker's queue"})
+    queued = proc.submit(draw, ([1.0, 2.0],), {"title": "queued"})
+    t0 = time.monotonic()
+    while not slow.running():   # handed to the worker
+        assert time.monotonic() - t0 < 60
+        time.sleep(0.01)
+    t0 = time.monotonic()
+    proc.close()
+    assert time.monotonic() - t0 < 2.0   # not the 8 s the worker is still drawing
+    assert queued.cancelled()
+    assert proc.submit(draw, ([1.0],), {}) is None and not proc.started
+
+
+def test_a_worker_that_cannot_start_or_has_broken_is_not_asked_again(monkeypatch):
+    """Once the pool cannot be started, or is broken, every later figure is drawn here at once:
+    no new start (seconds each) and no new submit per figure."""
+    import concurrent.futures
+
+    from geardyn.studies.figure_process import NotPicklable
+
+    starts = []
+
+    def no_pool(*args, **kwargs):
+        starts.append(kwargs)
+        raise OSError("no process to be had")
+
+    monkeypatch.setattr(concurrent.futures, "ProcessPoolExecutor", no_pool)
+    proc = FigureProcess()
+    assert proc.submit(draw, ([1.0],), {}) is None
+    assert proc.submit(draw, ([2.0],), {}) is None
+    assert len(starts) == 1 and not proc.started
+
+    class Broken:
+        submits = 0
+
+        def submit(self, *args):
+            Broken.submits += 1
+            raise RuntimeError("A process in the process pool was terminated abruptly")
+
+        def shutdown(self, **kwargs):
+            pass
+
+    proc = FigureProcess()
+    proc._pool = Broken()
+    assert proc.submit(draw, ([1.0],), {}) is None
+    assert proc.submit(draw, ([2.0],), {}) is None
+    assert Broken.submits == 1
+
+    with pytest.raises(NotPicklable) as info:   # says what pickle said, by its type
+        FigureProcess().submit(lambda: None, (), {})
+    cause = info.value.__cause__
+    assert str(info.value) == f"{type(cause).__name__}: {cause}"

@@ -89,6 +89,13 @@ class FigureProcess:
         self._ready = ready
         self._pool = None
         self._failed = False
+        self._futures: set = set()  # submitted, not done: what close() drops
+
+    def _track(self, future):
+        """Keep ``future`` until it is done (:meth:`close` cancels those still waiting)."""
+        self._futures.add(future)
+        future.add_done_callback(self._futures.discard)  # (set.add/discard: atomic)
+        return future
 
     @property
     def started(self) -> bool:
@@ -124,7 +131,7 @@ class FigureProcess:
         if self._pool is None:
             return self._start_with(payload)
         try:
-            return self._pool.submit(_draw_pickled, payload)
+            return self._track(self._pool.submit(_draw_pickled, payload))
         except RuntimeError:  # a broken pool (BrokenProcessPool is a RuntimeError), or shut down
             self._failed = True
             return None
@@ -146,12 +153,22 @@ class FigureProcess:
             self._failed = True
             return None
         self._pool = pool
-        return future
+        return self._track(future)
 
     def close(self, cancel: bool = True) -> None:
         """Stop the worker after the figure it is drawing (``cancel``: the queued ones are
-        dropped); it exits on its own, this process does not wait for it."""
+        dropped); it exits on its own, this process does not wait for it.
+
+        The queued figures are cancelled here: ``shutdown(cancel_futures=True)`` leaves that to
+        the pool's manager thread, which skips it once the pool object has been garbage
+        collected, as it is as soon as this returns (found by mutation testing, 2026-11-26).
+        The pool hands one call to the worker's queue ahead (its future already running):
+        that one is drawn before the worker exits.
+        """
         pool, self._pool = self._pool, None
         self._failed = True
+        if cancel:
+            for future in list(self._futures):
+                future.cancel()  # (False, and nothing done, for one already running)
         if pool is not None:
             pool.shutdown(wait=False, cancel_futures=cancel)
