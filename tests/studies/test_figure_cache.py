@@ -54,6 +54,10 @@ def test_without_cache_or_fingerprint_the_figure_is_drawn(tmp_path, monkeypatch)
     s = FigureStore()
     s.cached("f", draw, y, extra=object())             # cannot be fingerprinted: drawn, not cached
     assert CALLS == ["t", "t", "t"] and isinstance(s["f"], RenderedFigure)
+    s.cached("g", draw, y, title="keyword", extra=object())   # its keywords count (mutation test)
+    from geardyn.studies.paper_result import render_png
+
+    assert s["g"].png == render_png(draw(y, title="keyword"))
     assert not (tmp_path / "cache" / "figure").exists()
 
 

@@ -281,3 +281,87 @@ def test_a_worker_that_cannot_start_or_has_broken_is_not_asked_again(monkeypatch
         FigureProcess().submit(lambda: None, (), {})
     cause = info.value.__cause__
     assert str(info.value) == f"{type(cause).__name__}: {cause}"
+
+
+def _raw(store, key):
+    """The store's entry for ``key`` as it is (a pending figure is not collected)."""
+    return dict.__getitem__(store, key)
+
+
+def _wait(predicate, what, timeout=120.0):
+    import time
+
+    t0 = time.monotonic()
+    while not predicate():
+        assert time.monotonic() - t0 < timeout, what
+        time.sleep(0.01)
+
+
+def test_the_window_of_figures_in_flight_and_what_is_let_go(tmp_path, monkeypatch):
+    """Mutation testing (2026-11-26): nothing checked that the process is kept at
+    :data:`IN_FLIGHT` figures, that each one drawn lets the next go (without this process asking),
+    that a drawn figure's arguments are let go, that a figure drawn here while held is not sent
+    as well, that an unpicklable figure does not stop the ones behind it, or that ``finish``
+    and reading a figure leave no figure pending."""
+    monkeypatch.setenv("GEARDYN_NO_CACHE", "1")
+    y = np.linspace(0.0, 1.0, 30)
+    CALLS.clear()
+
+    store = FigureStore(FigureProcess())
+    for title in TITLES[:6]:
+        store.cached(title, draw, y, title=title)
+    assert store._in_flight == IN_FLIGHT and len(store._held) == 6 - IN_FLIGHT
+    _wait(lambda: all(_raw(store, t).future is not None and _raw(store, t).future.done()
+                      for t in TITLES[:6]), "the process did not draw every figure by itself")
+    _wait(lambda: store._in_flight == 0, "a drawn figure was not counted out")
+    assert not store._held and CALLS == []
+    for title in TITLES[:6]:
+        job = _raw(store, title)
+        assert job.args == () and job.kwargs == {}   # let go once drawn
+    assert store.get(TITLES[0]).png == _expected(y, TITLES[0])
+    assert isinstance(_raw(store, TITLES[0]), RenderedFigure) and None not in store
+    assert store.get("no such figure", "default") == "default"
+    store.finish()
+    assert all(isinstance(v, RenderedFigure) for v in dict.values(store))
+
+    ready = {"now": False}
+    held = FigureStore(FigureProcess(ready=lambda: ready["now"]))
+    held.cached("here", draw, y, title="here")
+    held.cached("lambda", draw_mapped, y, lambda v: v + 1.0, title="lambda")
+    held.cached("behind", draw, y, title="behind")
+    assert held["here"].png == _expected(y, "here")   # drawn here, while held
+    ready["now"] = True
+    held.cached("last", draw, y, title="last")
+    # "here" is not sent again; "lambda" cannot be sent; "behind" and "last" go
+    assert not held._held and held._in_flight == 2
+    assert _raw(held, "behind").future is not None and _raw(held, "lambda").future is None
+    held.finish()
+    assert CALLS == ["here", "lambda"]
+    assert all(isinstance(v, RenderedFigure) for v in dict.values(held))
+    assert held["lambda"].png == render_png(draw(y + 1.0, title="lambda"))
+
+
+def test_a_figure_another_store_has_cached_meanwhile_is_read_from_the_cache(tmp_path,
+                                                                            monkeypatch):
+    """Two stores hand the same figure to their processes; the first to collect it fills the
+    figure cache, the second reads it from there; a third store finds it cached when handed
+    the figure and starts no process at all."""
+    monkeypatch.setenv("GEARDYN_CACHE_DIR", str(tmp_path / "cache"))
+    y = np.linspace(0.0, 2.0, 40)
+    a, b = FigureStore(FigureProcess()), FigureStore(FigureProcess())
+    a.cached("f", draw, y, title="shared")
+    b.cached("f", draw, y, title="shared")
+    from geardyn.cache import record_lookups
+
+    png = a["f"].png
+    with record_lookups() as lookups:
+        assert b["f"].png == png
+    assert [(r["kind"], r["hit"]) for r in lookups] == [("figure", True)]
+    a.finish()
+    b.finish()
+    c = FigureStore(FigureProcess())
+    with record_lookups() as lookups:
+        c.cached("f", draw, y, title="shared")
+    assert not c.process.started and isinstance(_raw(c, "f"), RenderedFigure)
+    assert [(r["kind"], r["hit"]) for r in lookups] == [("figure", True)]
+    assert c["f"].png == png

@@ -278,13 +278,12 @@ class _Pending:
     as soon as the process has drawn the figure (they are only needed to draw it here instead),
     so the records and diagnoses a figure shows are not held until the report collects it."""
 
-    __slots__ = ("key", "digest", "draw", "args", "kwargs", "future", "here")
+    __slots__ = ("key", "digest", "draw", "args", "kwargs", "future")
 
     def __init__(self, key, digest: str | None, draw: Callable, args: tuple, kwargs: dict):
         self.key, self.digest = key, digest
         self.draw, self.args, self.kwargs = draw, args, kwargs
         self.future = None
-        self.here = False  # True: its arguments do not pickle, this process draws it
 
 
 #: Figures at most in the figure process's hands at once (sent, not drawn yet): each is a
@@ -352,9 +351,8 @@ class FigureStore(dict):
                 job = self._held[0]
                 try:
                     future = self.process.submit(job.draw, job.args, job.kwargs)
-                except NotPicklable:
+                except NotPicklable:  # drawn here when collected (its future stays None)
                     self._held.popleft()
-                    job.here = True
                     continue
                 if future is None:  # not yet (or never): they stay held
                     return
