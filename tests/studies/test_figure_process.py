@@ -288,7 +288,7 @@ def _raw(store, key):
     return dict.__getitem__(store, key)
 
 
-def _wait(predicate, what, timeout=120.0):
+def _wait(predicate, what, timeout=60.0):
     import time
 
     t0 = time.monotonic()
