@@ -196,14 +196,17 @@ def draw_sigint_state():
     return draw([0.0, 1.0], title="SIGINT ignored" if ignored else "SIGINT not ignored")
 
 
-def draw_slowly(seconds, *, title="slow"):
+def draw_when_released(path, *, title="slow"):
+    """A figure drawn once the file ``path`` exists (at most a minute later)."""
     import time
 
-    time.sleep(seconds)
+    t0 = time.monotonic()
+    while not os.path.exists(path) and time.monotonic() - t0 < 60.0:
+        time.sleep(0.01)
     return draw([0.0, 1.0], title=title)
 
 
-def test_one_spawned_worker_that_ignores_ctrl_c_and_close_does_not_wait():
+def test_one_spawned_worker_that_ignores_ctrl_c_and_close_does_not_wait(tmp_path):
     """Mutation testing (2026-11-26) found these unchecked: the pool has one worker, spawned
     (not forked from a process with threads), which ignores Ctrl-C even when the pool was
     started outside the main thread (where the parent cannot ignore it while starting);
@@ -226,19 +229,28 @@ def test_one_spawned_worker_that_ignores_ctrl_c_and_close_does_not_wait():
         assert time.monotonic() - t0 < 5.0
         time.sleep(0.01)
 
-    slow = proc.submit(draw_slowly, (4.0,), {})
-    # the pool hands one more call to the worker's queue at once (marked running); the one
-    # after it waits in the pool (pending): that one close() drops
-    proc.submit(draw, ([1.0, 2.0],), {"title": "in the worker's queue"})
-    queued = proc.submit(draw, ([1.0, 2.0],), {"title": "queued"})
-    t0 = time.monotonic()
-    while not slow.running():   # handed to the worker
-        assert time.monotonic() - t0 < 60
-        time.sleep(0.01)
+    release = tmp_path / "release"
+    slow = proc.submit(draw_when_released, (str(release),), {})
+    more = [proc.submit(draw, ([1.0, float(i)],), {"title": f"queued {i}"}) for i in range(4)]
+    # while the worker draws the slow figure, the pool moves one or two more into the worker's
+    # queue (their futures marked running: drawn anyway) and nothing else moves; the others
+    # wait in the pool (pending): those close() drops
+    state = {"running": -1, "since": time.monotonic()}
+
+    def settled() -> bool:
+        n = sum(f.running() for f in more)
+        if n != state["running"]:
+            state.update(running=n, since=time.monotonic())
+        return slow.running() and n >= 1 and time.monotonic() - state["since"] > 0.5
+
+    _wait(settled, "the worker did not take the slow figure")
+    pending = [f for f in more if not f.running() and not f.done()]
+    assert len(pending) >= 2
     t0 = time.monotonic()
     proc.close()
-    assert time.monotonic() - t0 < 2.0   # not the 4 s the worker is still drawing
-    assert queued.cancelled()
+    assert time.monotonic() - t0 < 5.0   # it does not wait for the figure being drawn
+    release.touch()
+    assert all(f.cancelled() for f in pending)
     assert proc.submit(draw, ([1.0],), {}) is None and not proc.started
 
 
