@@ -52,7 +52,7 @@ class Row:
     def margin(self) -> str:
         """How far the measured figure is inside (``"by 0.4 s"``) or outside (``"by 3.7 s"``,
         with ``met`` False) its target, in the row's unit; empty when the target is not a plain
-        comparison in that unit (``"<= 1.5x the C step"``, ``">= 80 %"`` of another figure)."""
+        comparison in that unit (``"<= 1.5x the C step"``, ``"< 600 MB"`` on a row in GB)."""
         m = _TARGET.match(self.target)
         if m is None or m.group(3) != self.unit or self.value != self.value:  # (NaN: skipped)
             return ""

@@ -188,6 +188,20 @@ def test_who_may_have_a_figure_process(monkeypatch):
     assert os.environ[FE_PROCESSES_ENV] == "2"
 
 
+def _raw(store, key):
+    """The store's entry for ``key`` as it is (a pending figure is not collected)."""
+    return dict.__getitem__(store, key)
+
+
+def _wait(predicate, what, timeout=60.0):
+    import time
+
+    t0 = time.monotonic()
+    while not predicate():
+        assert time.monotonic() - t0 < timeout, what
+        time.sleep(0.01)
+
+
 def draw_sigint_state():
     """A figure titled by how the process that draws it treats Ctrl-C."""
     import signal
@@ -293,20 +307,6 @@ def test_a_worker_that_cannot_start_or_has_broken_is_not_asked_again(monkeypatch
         FigureProcess().submit(lambda: None, (), {})
     cause = info.value.__cause__
     assert str(info.value) == f"{type(cause).__name__}: {cause}"
-
-
-def _raw(store, key):
-    """The store's entry for ``key`` as it is (a pending figure is not collected)."""
-    return dict.__getitem__(store, key)
-
-
-def _wait(predicate, what, timeout=60.0):
-    import time
-
-    t0 = time.monotonic()
-    while not predicate():
-        assert time.monotonic() - t0 < timeout, what
-        time.sleep(0.01)
 
 
 def test_the_window_of_figures_in_flight_and_what_is_let_go(tmp_path, monkeypatch):

@@ -162,8 +162,8 @@ class FigureProcess:
         The queued figures are cancelled here: ``shutdown(cancel_futures=True)`` leaves that to
         the pool's manager thread, which skips it once the pool object has been garbage
         collected, as it is as soon as this returns (found by mutation testing, 2026-11-26).
-        The pool hands one call to the worker's queue ahead (its future already running):
-        that one is drawn before the worker exits.
+        The pool hands one or two calls to the worker's queue ahead (their futures already
+        running): those are drawn before the worker exits.
         """
         pool, self._pool = self._pool, None
         self._failed = True
