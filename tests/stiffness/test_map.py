@@ -56,6 +56,23 @@ def test_numba_lookup_matches_numpy_twin(cmap):
         np.testing.assert_allclose(cmap(th, dd, variable), fast, rtol=0, equal_nan=True)
 
 
+def test_read_only_angles_use_the_compiled_lookup_of_writable_ones(cmap):
+    """numba types a read-only array apart: a read-only theta (or dd) would compile the lookup a
+    second time; the map copies it instead, so one signature serves both, with the same values."""
+    from geardyn.stiffness.map import _lookup_many
+
+    th = np.linspace(-1.0, 7.0, 50)
+    frozen = th.copy()
+    frozen.flags.writeable = False
+    dd = np.full(th.size, cmap.dd[1])
+    writable = cmap(th, dd)
+    signatures = list(_lookup_many.signatures)
+    np.testing.assert_array_equal(cmap(frozen, dd), writable)
+    np.testing.assert_array_equal(cmap(th, np.broadcast_to(cmap.dd[1], th.shape)), writable)
+    assert list(_lookup_many.signatures) == signatures
+    assert all(a.mutable for sig in signatures for a in sig[:2]), signatures
+
+
 def test_steps_stay_sharp_off_the_grid(case, cmap):
     """The number of pairs in contact read from the map equals the geometric count at random
     (theta, d) between grid lines. Points within 1e-5 rad of a true handover are skipped: the map

@@ -198,7 +198,9 @@ def _input_forcing(fp, n, sp_t, sp_w):
     if fp[FP_RIP_AMP] != 0.0:
         out += fp[FP_RIP_AMP] * math.sin(fp[FP_RIP_ORDER] * (n * fp[FP_HSTEP]) + fp[FP_RIP_PHASE])
     if fp[FP_DRIVE_GAIN] != 0.0:
-        wt = law_torque(3, 0.0, 0.0, 0.0, sp_t, sp_w, n * fp[FP_DT])
+        # np.int64(3), not 3: numba compiles a callee once more for each literal argument
+        # (Literal[int](3)); a typed value shares the compiled law_torque of the other calls
+        wt = law_torque(np.int64(3), 0.0, 0.0, 0.0, sp_t, sp_w, n * fp[FP_DT])
         out += fp[FP_DRIVE_GAIN] * (wt - fp[FP_WREF])
     return out
 
@@ -333,8 +335,8 @@ def _excite(th, tha, b1, rsum, dd, pfree, sep, eip, efp, etp, etg, els,
     z1 = eip[EI_Z1]
     z2 = eip[EI_Z2]
     nr = eip[EI_NR]
-    bp = EF_GEAR0
-    bg = EF_GEAR0 + EF_PER_GEAR
+    bp = np.int64(EF_GEAR0)  # typed, not literal: one compiled _relief (see _input_forcing)
+    bg = np.int64(EF_GEAR0 + EF_PER_GEAR)
     tot = 0.0
     sa = 0.0
     se = 0.0
@@ -614,7 +616,9 @@ def advance(n_steps, rec_start, decim, out, j, st, ist, fail,
                                                   sep, eip, efp, etp, etg, els, dd0, ddd,
                                                   phase_a, length_a, mesh_angle, n_cycles, n_seg,
                                                   kvals)
-        it = 0
+        # typed, not literal (see _input_forcing): numba's type inference would otherwise
+        # compile no_fixed_point and _fail for Literal[int](0) and Literal[bool](False) too
+        it = np.int64(0)
         res_b = np.nan
         res = np.nan
         kk = 0.0
@@ -624,7 +628,7 @@ def advance(n_steps, rec_start, decim, out, j, st, ist, fail,
         b2_m2 = np.nan
         k_first = 0.0
         k_m1 = 0.0
-        take_next = False
+        take_next = bool(it)  # False
         status = OK
         fel = st[S_FEL]  # the load the family is read at: first the last step's
         fel_new = fel

@@ -319,7 +319,8 @@ def advance_transverse(n_steps, rec_start, decim, out, j, st, ist, fail,
                 zc[i] = st[i] + dt * st[s_v + i] + 0.5 * dt * dt * st[s_a + i]
         th_ref = np.fmod(n * hstep, period) if ev_start else np.fmod((n + 1) * hstep, period)
         hbox = 0.5 * abs(hstep + dt * st[s_v + ithp]) if box else 0.0
-        it = 0
+        # typed, not literal: one compiled no_fixed_point and _fail (see _kernel._input_forcing)
+        it = np.int64(0)
         res_b = np.nan
         res = np.nan
         kk = 0.0
@@ -330,7 +331,7 @@ def advance_transverse(n_steps, rec_start, decim, out, j, st, ist, fail,
         b2_m2 = np.nan
         k_first = 0.0
         k_m1 = 0.0
-        take_next = False
+        take_next = bool(it)  # False
         status = K.OK
         dc, tau, phi = _geometry(zc, tip, rsum, t1t2)
         th_p = th_ref + zc[ithp]  # the predictor's pinion angle, kept over the iterations

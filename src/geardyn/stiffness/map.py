@@ -572,9 +572,15 @@ class StiffnessMap:
         except ValueError:
             raise InputError("dd", f"shape {d.shape}",
                              f"a shape that broadcasts with theta's {th.shape}") from None
-        out, bad = _lookup_many(th.ravel(), d.ravel(), *arr)
+        th_f, d_f = th.ravel(), d.ravel()
+        if not (th_f.flags.writeable and d_f.flags.writeable):
+            # numba types a read-only array apart and would compile the lookup a second time
+            # (0.5 s) for it: a read-only theta or dd (a broadcast scalar, a file's array) is
+            # copied instead
+            th_f, d_f = th_f.copy(), d_f.copy()
+        out, bad = _lookup_many(th_f, d_f, *arr)
         if bad >= 0:
-            raise InputError("theta", float(th.ravel()[bad]), "finite pinion angles [rad]")
+            raise InputError("theta", float(th_f[bad]), "finite pinion angles [rad]")
         return out.reshape(th.shape) if th.shape else float(out[0])
 
     def torsional(self, theta, dd=0.0) -> np.ndarray:
