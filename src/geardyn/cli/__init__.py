@@ -106,8 +106,10 @@ def main() -> None:
     """Entry point of the ``geardyn`` console script."""
     import warnings
 
+    from ..processes import skip_collection_at_exit
     from ._common import warning_line
 
+    skip_collection_at_exit()
     warnings.showwarning = warning_line
     command = typer.main.get_command(app)
     _tidy_help(command, {"help_option_names": ["-h", "--help"]})

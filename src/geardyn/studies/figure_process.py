@@ -69,10 +69,15 @@ def _draw_pickled(payload: bytes) -> bytes:
 
 
 def _worker_init() -> None:
-    """In the worker: Ctrl-C is the study's business (it stops the pool)."""
+    """In the worker: Ctrl-C is the study's business (it stops the pool); the exit skips the
+    garbage collector's last passes (:func:`geardyn.processes.skip_collection_at_exit`: the
+    study's process waits for this one to end)."""
     import signal
 
+    from ..processes import skip_collection_at_exit
+
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    skip_collection_at_exit()
 
 
 class FigureProcess:

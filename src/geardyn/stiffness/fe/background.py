@@ -43,6 +43,7 @@ from ...processes import (  # noqa: F401 - re-exported
     _available_memory,
     _without_main_module,
     fe_processes,
+    skip_collection_at_exit,
     starting_quietly,
 )
 
@@ -62,6 +63,7 @@ def _build_faulty_bodies(case, then: tuple = (), cache_root: str | None = None) 
     import sys
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the first process's business
+    skip_collection_at_exit()  # the first process may wait for this one's exit
     try:
         from ...cache import Cache
         from .model import FEStiffness
@@ -81,6 +83,7 @@ def _run_tasks(tasks: tuple) -> None:
     import sys
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the first process's business
+    skip_collection_at_exit()  # the first process may wait for this one's exit
     try:
         for task in tasks:
             task()
