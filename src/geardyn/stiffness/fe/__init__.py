@@ -51,9 +51,25 @@ from collections.abc import Callable
 import numpy as np
 
 from ..map import StiffnessMap
-from .model import FESettings, FEStiffness, body_influence
 
 __all__ = ["fe_map", "plot_mesh", "FEStiffness", "FESettings", "body_influence"]
+
+#: Names of :mod:`.model` this package offers, imported on first use: the model pulls in the
+#: contact code, its compiled kernels and SciPy's LAPACK bindings (0.2 s), which a run whose
+#: FE maps are all cached, or a look at :mod:`.background`'s policy, never needs.
+_FROM_MODEL = ("FESettings", "FEStiffness", "body_influence")
+
+
+def __getattr__(name: str):
+    if name in _FROM_MODEL:
+        from . import model
+
+        return getattr(model, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_FROM_MODEL))
 
 
 def fe_map(case, dd: np.ndarray, *, cracked: bool,
@@ -96,6 +112,8 @@ def fe_map(case, dd: np.ndarray, *, cracked: bool,
         n_bodies[0] = n
         if progress is not None:
             progress(i, n + dd.size)
+
+    from .model import FEStiffness
 
     model = FEStiffness(case, cracked=cracked, cache=cache, progress=p_bodies, crack=crack)
 
