@@ -4,7 +4,8 @@
 builds a faulty FE map's bodies (:mod:`geardyn.stiffness.fe.background`), one draws the report's
 figures (:mod:`geardyn.studies.figure_process`). :func:`fe_processes` is the one policy for
 both; :func:`starting_quietly` the one way to start them (spawned, without the caller's main
-script, Ctrl-C ignored). This module imports nothing heavy, so the CLI can check the setting
+script, Ctrl-C ignored); :func:`skip_collection_at_exit` shortens the exit of every process
+geardyn owns. This module imports nothing heavy, so the CLI can check the setting
 before it claims an output folder.
 """
 
@@ -20,14 +21,20 @@ __all__ = ["fe_processes", "starting_quietly", "skip_collection_at_exit", "FE_PR
 #: report's figures).
 FE_PROCESSES_ENV = "GEARDYN_FE_PROCESSES"
 
+#: Available memory [bytes] below which the default is one process (two paper bodies factorised
+#: at once peak at about 1.2 GB for the whole ``geardyn run``, measured 2026-11-26).
+MIN_AVAILABLE_BYTES = 3 * 1024 ** 3
+
+
 def skip_collection_at_exit() -> None:
     """Let this process exit without the garbage collector's last passes: :func:`gc.freeze`
     from an :mod:`atexit` handler.
 
     An interpreter that has imported numba, matplotlib, xarray and SciPy spends most of its exit
-    in the collector's passes over every object still alive: 0.5-0.6 s of a warm ``geardyn run``
-    (3.71 s against 4.23 s, four runs each, 2026-11-26), and as long in the figure process, whose
-    exit the first process waits for. The other exit handlers run as before (temporary folders,
+    in the collector's passes over every object still alive: about 0.4 s of a warm ``geardyn
+    run`` (3.58-3.72 s against 4.00-4.10 s, four alternating runs, 2026-11-26), and as long in
+    the figure process, whose exit the first process waits for (``--quick``: 12.5-13.5 s against
+    14.4-14.8 s). The other exit handlers run as before (temporary folders,
     multiprocessing's finalizers, logging); only the collection is skipped, so an object left
     in a reference cycle is not finalised at exit, which Python does not promise anyway (geardyn
     closes its files itself and writes them under a temporary name, then renames). For
@@ -38,11 +45,6 @@ def skip_collection_at_exit() -> None:
     import gc
 
     atexit.register(gc.freeze)
-
-
-#: Available memory [bytes] below which the default is one process (two paper bodies factorised
-#: at once peak at about 1.2 GB for the whole ``geardyn run``, measured 2026-11-26).
-MIN_AVAILABLE_BYTES = 3 * 1024 ** 3
 
 
 def _available_memory() -> int | None:
