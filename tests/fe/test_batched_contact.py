@@ -251,3 +251,52 @@ def test_singular_active_set_is_skipped_like_the_reference():
     assert fast.rotation == ref.rotation
     assert ref.force.tolist() == [torque / 0.05, 0.0]
     assert ref.rotation == pytest.approx(2e-9 * torque / 0.05 ** 2, rel=1e-12)
+
+
+@pytest.mark.slow
+def test_contact_kernels_compile_no_array_routine(tmp_path):
+    """The compiled contact routines allocate nothing (their callers pass outputs and
+    workspace, ``_batch._workspace``): compiled from a fresh numba cache, the completion, the
+    batch and the single solve compile geardyn's functions, once each, and numba's ``max``, but
+    none of numba's array routines (``np.zeros``, ``np.empty``, ``np.ascontiguousarray``...,
+    each compiled once per array type: 1.0-1.7 s of the first run's compilation before they
+    went, module docstring). Fails on the allocating version (19 array routines)."""
+    import os
+    import subprocess
+    import sys
+    import textwrap
+
+    code = textwrap.dedent("""
+        import numpy as np
+        from numba.core import event
+        compiled = []
+        class Listener(event.Listener):
+            def on_start(self, ev):
+                pass
+            def on_end(self, ev):
+                f = ev.data["dispatcher"].py_func
+                compiled.append(f"{f.__module__}:{f.__qualname__}")
+        event.register("numba:compile", Listener())
+        from geardyn.stiffness.fe import _batch
+        rng = np.random.default_rng(1)
+        _batch.complete_nb(rng.random((5, 3)) * 0.03, 0.005, 0.025, 0.03, 0.1, 0.02, 0.03,
+                           0.05, 0.006, 0.008)
+        c0 = np.stack([np.eye(3) * 1e-10] * 4)
+        gap, arm, rad = np.zeros((4, 3)), np.full((4, 3), 0.02), np.full((4, 3), 0.01)
+        _batch.solve_batch(c0, gap, arm, 100.0, rad, plane_modulus=(2.2e11, 2.2e11),
+                           half_width=1e-4)
+        _batch.solve_compatibility_fast(c0[0], gap[0], arm[0], 100.0, rad[0],
+                                        plane_modulus=(2.2e11, 2.2e11), half_width=1e-4)
+        print("\\n".join(compiled))
+    """)
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba"))
+    r = subprocess.run([sys.executable, "-c", code], env=env, text=True, capture_output=True,
+                       timeout=300)
+    assert r.returncode == 0, r.stderr
+    compiled = r.stdout.split()
+    ours = [c.split(":")[1] for c in compiled if c.startswith("geardyn.stiffness.fe._batch:")]
+    assert sorted(ours) == sorted(["_wrap_angle", "_complete_nb", "_gesv", "_try", "_qp_nb",
+                                   "_solve_nb", "_solve_batch_nb"]), compiled
+    others = [c for c in compiled if not c.startswith("geardyn.stiffness.fe._batch:")]
+    assert others and all(c == "numba.cpython.builtins:ol_max.<locals>.impl" for c in others), \
+        others

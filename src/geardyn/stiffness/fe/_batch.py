@@ -18,6 +18,14 @@ r"""Compiled twins of the contact computations of :mod:`.contact` (issue 16, ite
   operation; only ``math.hypot`` differs (numba calls the C library's, Python has its own), so
   lengths can differ in the last bit.
 
+The compiled functions allocate nothing: their outputs and workspace are NumPy arrays made by
+the Python functions that call them (:func:`_workspace`). numba compiles each allocating routine
+(``np.zeros``, ``np.empty``, ``np.ascontiguousarray``: 19 of them) once per array type and
+process; with them the contact completion and batch took 4.3-4.7 s to compile in a fresh numba
+cache, without them 2.7-3.6 s (three alternating runs, numba's compile events, 2026-11-26),
+with bit-identical results (and paper FE maps).
+The KKT matrices are written column by column straight into the buffer LAPACK reads.
+
 Used by :meth:`.model.FEStiffness.evaluate` (``compiled=True``); the maps agree with the
 per-position pure-Python reference to 1e-9 relative (tests/fe/test_batched_contact.py; 6e-12
 measured over the cracked paper map, benchmarks/bench_fe_eval.py). ``fastmath=False``
@@ -65,56 +73,48 @@ _DGESV = types.ExternalFunction("geardyn_dgesv", types.void(*[types.voidptr] * 8
 
 
 @njit(cache=True, fastmath=False)
-def _gesv(mat, rhs):
-    """Solve ``mat x = rhs`` (square, C order; neither is changed) by LAPACK ``dgesv`` (LU with
-    partial pivoting). Returns ``(x, info)``: ``info > 0`` is an exactly zero pivot (singular
-    matrix, where ``np.linalg.solve`` raises ``LinAlgError``), and ``x`` is then undefined."""
-    n = rhs.size
-    a = np.ascontiguousarray(mat.T)  # the column-major layout LAPACK reads
-    x = rhs.copy()
-    ints = np.empty(4, np.int32)  # n, nrhs, lda = ldb, info
-    ints[0] = n
+def _gesv(mat, x, k, ints, ipiv):
+    """Solve ``A y = x`` in place by LAPACK ``dgesv`` (LU with partial pivoting): ``mat`` holds
+    the ``k x k`` matrix ``A`` column by column in its first ``k * k`` entries (the layout
+    LAPACK reads; overwritten by the factors), ``x`` the right-hand side in its first ``k``
+    (overwritten by ``y``); ``ints`` (int32, 4) and ``ipiv`` (int32, >= k) are workspace.
+    Returns LAPACK's ``info``: ``> 0`` is an exactly zero pivot (singular matrix, where
+    ``np.linalg.solve`` raises ``LinAlgError``), and ``x`` is then undefined."""
+    ints[0] = k
     ints[1] = 1
-    ints[2] = max(n, 1)
+    ints[2] = max(k, 1)
     ints[3] = 0
-    ipiv = np.empty(max(n, 1), np.int32)
-    _DGESV(ints[0:].ctypes, ints[1:].ctypes, a.ctypes, ints[2:].ctypes, ipiv.ctypes,
+    _DGESV(ints[0:].ctypes, ints[1:].ctypes, mat.ctypes, ints[2:].ctypes, ipiv.ctypes,
            x.ctypes, ints[2:].ctypes, ints[3:].ctypes)
-    return x, ints[3]
+    return ints[3]
 
 
 @njit(cache=True, fastmath=False)
-def _try(c, g, a, torque, sel, amax, scale_f, f, w):
+def _try(c, g, a, torque, sel, amax, scale_f, f, w, idx, mat, rhs, ints, ipiv):
     n = g.size
     k = 0
     for j in range(n):
         if sel[j]:
+            idx[k] = j
             k += 1
-    idx = np.empty(k, np.int64)
-    q = 0
-    for j in range(n):
-        if sel[j]:
-            idx[q] = j
-            q += 1
-    mat = np.zeros((k + 1, k + 1))
-    rhs = np.empty(k + 1)
-    for p in range(k):
+    m = k + 1
+    for p in range(k):  # the KKT matrix, column-major: entry (row p, column r) at p + r * m
         for r in range(k):
-            mat[p, r] = c[idx[p], idx[r]]
-        mat[p, k] = -a[idx[p]]
-        mat[k, p] = a[idx[p]]
+            mat[p + r * m] = c[idx[p], idx[r]]
+        mat[p + k * m] = -a[idx[p]]
+        mat[k + p * m] = a[idx[p]]
         rhs[p] = -g[idx[p]]
+    mat[k + k * m] = 0.0
     rhs[k] = torque
     # Like the reference, an exactly singular KKT matrix (LAPACK gesv reports a zero pivot, where
     # NumPy raises LinAlgError) skips this set and the enumeration tries the next one.
-    sol, info = _gesv(mat, rhs)
-    if info != 0:
+    if _gesv(mat, rhs, m, ints, ipiv) != 0:
         return False, 0.0
     for j in range(n):
         f[j] = 0.0
     for p in range(k):
-        f[idx[p]] = sol[p]
-    dth = sol[k]
+        f[idx[p]] = rhs[p]
+    dth = rhs[k]
     for j in range(n):
         if f[j] < -1e-10 * scale_f:
             return False, dth
@@ -138,7 +138,7 @@ def _try(c, g, a, torque, sel, amax, scale_f, f, w):
 
 
 @njit(cache=True, fastmath=False)
-def _qp_nb(c, g, a, torque, first, table, f, w):
+def _qp_nb(c, g, a, torque, first, table, f, w, idx, mat, rhs, ints, ipiv):
     n = g.size
     amax = a[0]
     for j in range(n):
@@ -150,7 +150,7 @@ def _qp_nb(c, g, a, torque, first, table, f, w):
         if first[j]:
             anyfirst = True
     if anyfirst:
-        ok, dth = _try(c, g, a, torque, first, amax, scale_f, f, w)
+        ok, dth = _try(c, g, a, torque, first, amax, scale_f, f, w, idx, mat, rhs, ints, ipiv)
         if ok:
             return True, dth
     for r in range(table.shape[0]):
@@ -161,7 +161,8 @@ def _qp_nb(c, g, a, torque, first, table, f, w):
                     same = False
             if same:
                 continue
-        ok, dth = _try(c, g, a, torque, table[r], amax, scale_f, f, w)
+        ok, dth = _try(c, g, a, torque, table[r], amax, scale_f, f, w, idx, mat, rhs, ints,
+                       ipiv)
         if ok:
             return True, dth
     return False, 0.0
@@ -169,21 +170,22 @@ def _qp_nb(c, g, a, torque, first, table, f, w):
 
 @njit(cache=True, fastmath=False)
 def _solve_nb(c0, gap, arm, torque, radius, e1, e2, estar, half_width, local, table,
-              tol, max_iter):
+              tol, max_iter, f, w, fn, c, first, idx, mat, rhs, ints, ipiv):
+    """One contact problem; ``f`` (force) and ``w`` (separation) are written, the arrays after
+    them are workspace (:func:`_workspace`). Returns ``(status, rotation, iterations)``."""
     n = gap.size
-    f = np.zeros(n)
-    w = np.zeros(n)
-    first = np.empty(n, np.bool_)
     for j in range(n):
+        f[j] = 0.0
+        w[j] = 0.0
         first[j] = gap[j] <= 0
-    ok, dth = _qp_nb(c0, gap, arm, torque, first, table, f, w)
+    ok, dth = _qp_nb(c0, gap, arm, torque, first, table, f, w, idx, mat, rhs, ints, ipiv)
     if not ok:
-        return 1, f, dth, w, 0
+        return 1, dth, 0
     it = 0
     if local:
         cf = -(2 / math.pi) * (1 / e1 + 1 / e2)
-        c = np.empty((n, n))
-        fn = np.zeros(n)
+        for j in range(n):
+            fn[j] = 0.0
         converged = False
         for k in range(1, max_iter + 1):
             it = k
@@ -195,9 +197,10 @@ def _solve_nb(c0, gap, arm, torque, radius, e1, e2, estar, half_width, local, ta
                 b = math.sqrt(4 * fj * radius[j] / (math.pi * estar))
                 c[j, j] = c[j, j] + cf * math.log(b / half_width)
                 first[j] = f[j] > 0
-            ok, dth_new = _qp_nb(c, gap, arm, torque, first, table, fn, w)
+            ok, dth_new = _qp_nb(c, gap, arm, torque, first, table, fn, w, idx, mat, rhs, ints,
+                                 ipiv)
             if not ok:
-                return 1, f, dth, w, it
+                return 1, dth, it
             dmax = 0.0
             fmax = fn[0]
             for j in range(n):
@@ -214,8 +217,17 @@ def _solve_nb(c0, gap, arm, torque, radius, e1, e2, estar, half_width, local, ta
                 converged = True
                 break
         if not converged:
-            return 2, f, dth, w, it
-    return 0, f, dth, w, it
+            return 2, dth, it
+    return 0, dth, it
+
+
+def _workspace(n: int) -> tuple:
+    """Workspace of :func:`_solve_nb` for ``n`` candidates: ``fn``, ``c``, ``first``, ``idx``,
+    ``mat``, ``rhs``, ``ints``, ``ipiv``, allocated here rather than in compiled code (see the
+    module docstring)."""
+    return (np.zeros(n), np.zeros((n, n)), np.zeros(n, np.bool_), np.zeros(n, np.int64),
+            np.zeros((n + 1) * (n + 1)), np.zeros(n + 1), np.zeros(4, np.int32),
+            np.zeros(n + 1, np.int32))
 
 
 def solve_compatibility_fast(c0, gap, arm, torque, radius, *, plane_modulus, half_width,
@@ -244,11 +256,12 @@ def solve_compatibility_fast(c0, gap, arm, torque, radius, *, plane_modulus, hal
     gap = np.ascontiguousarray(gap, float)
     e1, e2 = plane_modulus
     estar = 1.0 / (1.0 / e1 + 1.0 / e2)
-    status, f, dth, w, it = _solve_nb(np.ascontiguousarray(c0, float), gap,
-                                      np.ascontiguousarray(arm, float), float(torque),
-                                      np.ascontiguousarray(radius, float), float(e1), float(e2),
-                                      estar, float(half_width), bool(local),
-                                      subset_table(gap.size), float(tol), int(max_iter))
+    f, w = np.zeros(gap.size), np.zeros(gap.size)
+    status, dth, it = _solve_nb(np.ascontiguousarray(c0, float), gap,
+                                np.ascontiguousarray(arm, float), float(torque),
+                                np.ascontiguousarray(radius, float), float(e1), float(e2),
+                                estar, float(half_width), bool(local), subset_table(gap.size),
+                                float(tol), int(max_iter), f, w, *_workspace(gap.size))
     if status == 1:
         raise NumericalError("no solution of the contact compatibility problem",
                              state={"candidates": gap.size})
@@ -259,23 +272,15 @@ def solve_compatibility_fast(c0, gap, arm, torque, radius, *, plane_modulus, hal
 
 @njit(cache=True, fastmath=False)
 def _solve_batch_nb(c0, gap, arm, torque, radius, e1, e2, estar, half_width, local, table,
-                    tol, max_iter):
-    npos, n = gap.shape
-    status = np.zeros(npos, np.int64)
-    force = np.zeros((npos, n))
-    rotation = np.zeros(npos)
-    separation = np.zeros((npos, n))
-    iterations = np.zeros(npos, np.int64)
-    for p in range(npos):
-        st, f, dth, w, it = _solve_nb(c0[p], gap[p], arm[p], torque, radius[p], e1, e2, estar,
-                                      half_width, local, table, tol, max_iter)
+                    tol, max_iter, status, force, rotation, separation, iterations, fn, c, first,
+                    idx, mat, rhs, ints, ipiv):
+    for p in range(gap.shape[0]):
+        st, dth, it = _solve_nb(c0[p], gap[p], arm[p], torque, radius[p], e1, e2, estar,
+                                half_width, local, table, tol, max_iter, force[p],
+                                separation[p], fn, c, first, idx, mat, rhs, ints, ipiv)
         status[p] = st
         rotation[p] = dth
         iterations[p] = it
-        for j in range(n):
-            force[p, j] = f[j]
-            separation[p, j] = w[j]
-    return status, force, rotation, separation, iterations
 
 
 def solve_batch(c0, gap, arm, torque, radius, *, plane_modulus, half_width, local=True,
@@ -316,11 +321,14 @@ def solve_batch(c0, gap, arm, torque, radius, *, plane_modulus, half_width, loca
         raise ValueError("solve_batch expects gaps of shape (positions, candidates)")
     e1, e2 = plane_modulus
     estar = 1.0 / (1.0 / e1 + 1.0 / e2)
-    return _solve_batch_nb(np.ascontiguousarray(c0, float), gap,
-                           np.ascontiguousarray(arm, float), float(torque),
-                           np.ascontiguousarray(radius, float), float(e1), float(e2), estar,
-                           float(half_width), bool(local), subset_table(gap.shape[1]), float(tol),
-                           int(max_iter))
+    npos, n = gap.shape
+    out = (np.zeros(npos, np.int64), np.zeros((npos, n)), np.zeros(npos), np.zeros((npos, n)),
+           np.zeros(npos, np.int64))
+    _solve_batch_nb(np.ascontiguousarray(c0, float), gap, np.ascontiguousarray(arm, float),
+                    float(torque), np.ascontiguousarray(radius, float), float(e1), float(e2),
+                    estar, float(half_width), bool(local), subset_table(n), float(tol),
+                    int(max_iter), *out, *_workspace(n))
+    return out
 
 
 @njit(cache=True, fastmath=False)
@@ -329,21 +337,11 @@ def _wrap_angle(a):
 
 
 @njit(cache=True, fastmath=False)
-def complete_nb(s, s_start, s_end, t1t2, o2x, o2y, rb1, rb2, ua1, ua2):
-    """Compiled twin of :meth:`.contact.CandidateGenerator.complete` on a block of positions.
-
-    ``s`` (p, n): LOA positions of the candidates [m]. Returns ``kind, u1, u2, gap, arm,
-    radius`` of shape (p, n) with the operations of the reference in the same order (the
-    reference's ``math.hypot`` is Python's own algorithm, numba's the C library's, so ``r`` may
-    differ from it in the last bit).
-    """
+def _complete_nb(s, s_start, s_end, t1t2, o2x, o2y, rb1, rb2, ua1, ua2, kind, u1, u2, gap, arm,
+                 radius):
+    """:func:`complete_nb` into the given arrays (``kind``, ``u1``, ``u2``, ``gap``, ``arm``,
+    ``radius``, each of the shape of ``s``, all written)."""
     npos, n = s.shape
-    kind = np.zeros((npos, n), np.int64)
-    u1 = np.empty((npos, n))
-    u2 = np.empty((npos, n))
-    gap = np.zeros((npos, n))
-    arm = np.empty((npos, n))
-    radius = np.empty((npos, n))
     for p in range(npos):
         for k in range(n):
             sk = s[p, k]
@@ -351,6 +349,7 @@ def complete_nb(s, s_start, s_end, t1t2, o2x, o2y, rb1, rb2, ua1, ua2):
             a2 = t1t2 - sk
             g = 0.0
             lever = rb1
+            kind[p, k] = 0
             if sk > s_end:  # pinion tip corner
                 kind[p, k] = 1
                 beta = (sk - ua1) / rb1
@@ -388,4 +387,28 @@ def complete_nb(s, s_start, s_end, t1t2, o2x, o2y, rb1, rb2, ua1, ua2):
             rho1 = max(a1, 1e-9)
             rho2 = max(a2, 1e-9)
             radius[p, k] = rho1 * rho2 / (rho1 + rho2)
-    return kind, u1, u2, gap, arm, radius
+
+
+def complete_nb(s, s_start, s_end, t1t2, o2x, o2y, rb1, rb2, ua1, ua2):
+    """Compiled twin of :meth:`.contact.CandidateGenerator.complete` on a block of positions.
+
+    Parameters
+    ----------
+    s : ndarray, shape (p, n)
+        LOA positions of the candidates [m].
+    s_start, s_end, t1t2, o2x, o2y, rb1, rb2, ua1, ua2 : float
+        The operating geometry (as in :meth:`.contact.CandidateGenerator.complete`) [m].
+
+    Returns
+    -------
+    kind, u1, u2, gap, arm, radius : ndarray, shape (p, n)
+        Computed by :func:`_complete_nb` with the operations of the reference in the same order
+        (the reference's ``math.hypot`` is Python's own algorithm, numba's the C library's, so
+        the corner distance may differ from it in the last bit). The arrays are allocated here,
+        not in compiled code (:func:`_workspace`).
+    """
+    s = np.ascontiguousarray(s, float)
+    out = (np.zeros(s.shape, np.int64), *(np.zeros(s.shape) for _ in range(5)))
+    _complete_nb(s, float(s_start), float(s_end), float(t1t2), float(o2x), float(o2y),
+                 float(rb1), float(rb2), float(ua1), float(ua2), *out)
+    return out
