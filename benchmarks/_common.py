@@ -94,28 +94,53 @@ def _pss_kb(pid: int) -> int:
     return 0
 
 
-def _tree_rss_kb(root: int) -> tuple[int, int]:
-    """Resident memory [kB] of ``root`` and all its descendants now (Linux ``/proc``): the sum
-    of their resident sets, and the sum of their proportional set sizes (:func:`_pss_kb`),
-    which counts a page shared by several of them once: the libraries every Python process
-    maps, and a process forked from another before it executes a new program (a spawned
-    worker's first milliseconds), which the sum of resident sets counts twice."""
+def _children(pid: int) -> list[int] | None:
+    """Child processes of ``pid`` (``/proc/<pid>/task/<tid>/children``); None where the kernel
+    has no such file."""
     import os
 
-    parent: dict[int, int] = {}
-    rss: dict[int, int] = {}
-    for entry in os.listdir("/proc"):
-        if not entry.isdigit():
-            continue
+    out: list[int] = []
+    try:
+        tasks = os.listdir(f"/proc/{pid}/task")
+    except OSError:
+        return []  # the process has ended
+    for tid in tasks:
         try:
-            with open(f"/proc/{entry}/stat") as fh:
-                fields = fh.read().rsplit(")", 1)[1].split()
-            with open(f"/proc/{entry}/statm") as fh:
-                pages = int(fh.read().split()[1])
-        except (OSError, IndexError, ValueError):
+            with open(f"/proc/{pid}/task/{tid}/children") as fh:
+                out += [int(c) for c in fh.read().split()]
+        except FileNotFoundError:
+            if not os.path.exists(f"/proc/{pid}/task/{tid}"):
+                continue  # the thread has ended
+            return None  # no children file: the caller scans /proc
+        except (OSError, ValueError):
             continue
-        parent[int(entry)] = int(fields[1])
-        rss[int(entry)] = pages * (os.sysconf("SC_PAGE_SIZE") // 1024)
+    return out
+
+
+def _tree(root: int) -> set[int]:
+    """``root`` and all its descendants now: from the ``children`` files (a few reads), or,
+    where the kernel has none, from the parent field of every process in ``/proc``."""
+    import os
+
+    tree, frontier = {root}, [root]
+    while frontier:
+        kids = _children(frontier.pop())
+        if kids is None:
+            break
+        for child in kids:
+            if child not in tree:
+                tree.add(child)
+                frontier.append(child)
+    else:
+        return tree
+    parent: dict[int, int] = {}
+    for entry in os.listdir("/proc"):
+        if entry.isdigit():
+            try:
+                with open(f"/proc/{entry}/stat") as fh:
+                    parent[int(entry)] = int(fh.read().rsplit(")", 1)[1].split()[1])
+            except (OSError, IndexError, ValueError):
+                continue
     tree, frontier = {root}, [root]
     while frontier:
         p = frontier.pop()
@@ -123,16 +148,48 @@ def _tree_rss_kb(root: int) -> tuple[int, int]:
             if par == p and child not in tree:
                 tree.add(child)
                 frontier.append(child)
-    return sum(rss.get(p, 0) for p in tree), sum(_pss_kb(p) for p in tree)
+    return tree
 
 
-def run_measured(cmd: list[str], env: dict, *, interval: float = 0.05
+def _rss_kb(pid: int) -> int:
+    """Resident set [kB] of ``pid`` (``/proc/<pid>/statm``); 0 where unreadable."""
+    import os
+
+    try:
+        with open(f"/proc/{pid}/statm") as fh:
+            return int(fh.read().split()[1]) * (os.sysconf("SC_PAGE_SIZE") // 1024)
+    except (OSError, IndexError, ValueError):
+        return 0
+
+
+def _tree_rss_kb(root: int, pss: bool = True) -> tuple[int, int | None]:
+    """Resident memory [kB] of ``root`` and all its descendants now (Linux ``/proc``): the sum
+    of their resident sets, and (``pss``) the sum of their proportional set sizes
+    (:func:`_pss_kb`), which counts a page shared by several of them once: the libraries every
+    Python process maps, and a process forked from another before it executes a new program
+    (a spawned worker's first milliseconds), which the sum of resident sets counts twice.
+
+    The resident sets cost about 0.1 ms a sample; a proportional set size about 4 ms per
+    process (the kernel walks the process's page tables; measured 2026-11-26 on a 300 MB
+    Python process), which is why :func:`run_measured` asks for it only every tenth sample."""
+    tree = _tree(root)
+    return (sum(_rss_kb(p) for p in tree),
+            sum(_pss_kb(p) for p in tree) if pss else None)
+
+
+def run_measured(cmd: list[str], env: dict, *, interval: float = 0.05, pss_every: int = 10
                  ) -> tuple[float, float, float, float]:
     """Run ``cmd``; return its wall time [s], the peak of the *summed* resident memory of the
     process and its children [MB] (sampled every ``interval`` s from ``/proc``; 0 where there
     is none), its own peak resident set [MB] (``ru_maxrss`` from ``wait4``: the largest single
     process of the tree, not their sum) and the peak of their summed proportional set sizes
-    [MB] (:func:`_tree_rss_kb`: shared pages counted once; 0 where ``/proc`` has none).
+    [MB] (:func:`_tree_rss_kb`: shared pages counted once; sampled every ``pss_every``-th
+    sample only, as it costs about 4 ms per process; 0 where ``/proc`` has none).
+
+    The sampler runs beside the command on the same cores: until 2026-11-26 it read every
+    process's proportional set size at every sample, about 15 ms of CPU every 50 ms with three
+    processes (a third of a core), which made ``geardyn run --quick`` 2-3 s slower in the
+    benchmark than timed alone (measured 2026-11-26, docs/performance.md).
 
     Raises ``RuntimeError`` with the command's stderr if it fails.
     """
@@ -148,10 +205,14 @@ def run_measured(cmd: list[str], env: dict, *, interval: float = 0.05
         done = threading.Event()
 
         def sample() -> None:
+            k = 0
             while not done.is_set():
                 if os.path.isdir("/proc"):
-                    rss, pss = _tree_rss_kb(p.pid)
-                    peak[0], peak[1] = max(peak[0], rss), max(peak[1], pss)
+                    rss, pss = _tree_rss_kb(p.pid, pss=k % pss_every == 0)
+                    peak[0] = max(peak[0], rss)
+                    if pss is not None:
+                        peak[1] = max(peak[1], pss)
+                k += 1
                 done.wait(interval)
 
         th = threading.Thread(target=sample, daemon=True)
