@@ -31,3 +31,50 @@ def test_margin_in_the_rows_unit_only():
     assert Row("memory", 0.97, "GB", target="< 600 MB", met=False).margin == ""
     assert Row("no target", 1.0, "s").margin == ""
     assert Row("skipped", math.nan, "s", target="< 1 s").margin == ""
+
+
+def test_memory_of_a_process_tree(tmp_path, monkeypatch):
+    """The benchmark's memory sampler sums a process and its child (the children files, and the
+    scan of ``/proc`` where there are none): a parent holding 80 MB and its child holding
+    120 MB, both alive (the child says so by a file), read at least 200 MB and at most 200 MB
+    plus two interpreters; the proportional set size lies between 0 and the resident sum."""
+    import os
+    import subprocess
+    import textwrap
+    import time
+
+    import pytest
+
+    if not os.path.isdir("/proc"):
+        pytest.skip("no /proc on this system: the benchmark reads 0 MB here")
+    ready = tmp_path / "ready"
+    child = ("import pathlib, sys; held = b'c' * (120 * 2**20); "
+             "pathlib.Path(sys.argv[1]).write_text('x'); sys.stdin.read()")
+    code = textwrap.dedent(f"""
+        import subprocess, sys
+        held = b'p' * (80 * 2**20)
+        child = subprocess.Popen([sys.executable, "-c", {child!r}, {str(ready)!r}],
+                                 stdin=subprocess.PIPE)
+        sys.stdin.read()
+        child.stdin.close()
+        child.wait()
+    """)
+    proc = subprocess.Popen([sys.executable, "-c", code], stdin=subprocess.PIPE)
+    try:
+        t0 = time.monotonic()
+        while not ready.exists():
+            assert proc.poll() is None and time.monotonic() - t0 < 120
+            time.sleep(0.01)
+        mb = 1024  # kB
+        tree = common._tree(proc.pid)
+        assert len(tree) == 2 and proc.pid in tree
+        rss, pss = common._tree_rss_kb(proc.pid)
+        assert 200 * mb <= rss <= (200 + 2 * 60) * mb, rss / mb
+        assert 0 < pss <= rss
+        rss_only, none = common._tree_rss_kb(proc.pid, pss=False)
+        assert none is None and 200 * mb <= rss_only <= (200 + 2 * 60) * mb
+        monkeypatch.setattr(common, "_children", lambda pid: None)  # a kernel without them
+        assert common._tree(proc.pid) == tree
+    finally:
+        proc.stdin.close()
+        proc.wait(timeout=60)
