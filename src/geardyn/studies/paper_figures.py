@@ -265,7 +265,10 @@ def fig_pwvd_pair(diags: dict, sig: str, which: str, teeth: int, max_order: floa
         # then scales in float32 too (a cold run's memory peak was drawing these figures)
         img = np.ascontiguousarray(d.T, dtype=np.float32)
         del pw, d
+        # interpolation_stage="data": the nearest cell picked first, then coloured (the same
+        # pixels as colouring every cell first, matplotlib's choice when it shrinks an image)
         im = ax.imshow(img, origin="lower", aspect="auto", interpolation="nearest",
+                       interpolation_stage="data",
                        extent=(0.0, 360.0, o[0] - step / 2, o[-1] + step / 2),
                        cmap="viridis", vmin=0, vmax=vmax)
         ax.set_ylim(max(o[0] - step / 2, 0.0), o[-1] + step / 2)
