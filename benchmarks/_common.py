@@ -169,7 +169,7 @@ def _tree_rss_kb(root: int, pss: bool = True) -> tuple[int, int | None]:
     Python process maps, and a process forked from another before it executes a new program
     (a spawned worker's first milliseconds), which the sum of resident sets counts twice.
 
-    The resident sets cost about 0.1 ms a sample; a proportional set size about 4 ms per
+    The resident sets cost about 0.3 ms a sample; a proportional set size about 4 ms per
     process (the kernel walks the process's page tables; measured 2026-11-26 on a 300 MB
     Python process), which is why :func:`run_measured` asks for it only every tenth sample."""
     tree = _tree(root)
@@ -188,8 +188,8 @@ def run_measured(cmd: list[str], env: dict, *, interval: float = 0.05, pss_every
 
     The sampler runs beside the command on the same cores: until 2026-11-26 it read every
     process's proportional set size at every sample, about 15 ms of CPU every 50 ms with three
-    processes (a third of a core), which made ``geardyn run --quick`` 2-3 s slower in the
-    benchmark than timed alone (measured 2026-11-26, docs/performance.md).
+    processes (a third of a core), which made ``geardyn run --quick`` about 1.6 s (12 %) slower
+    than timed alone (measured 2026-11-26, docs/performance.md).
 
     Raises ``RuntimeError`` with the command's stderr if it fails.
     """
