@@ -122,30 +122,24 @@ def _tree(root: int) -> set[int]:
     where the kernel has none, from the parent field of every process in ``/proc``."""
     import os
 
+    children_of = _children
+    if _children(root) is None:  # a kernel without the children files: scan /proc once
+        parent: dict[int, int] = {}
+        for entry in os.listdir("/proc"):
+            if entry.isdigit():
+                try:
+                    with open(f"/proc/{entry}/stat") as fh:
+                        parent[int(entry)] = int(fh.read().rsplit(")", 1)[1].split()[1])
+                except (OSError, IndexError, ValueError):
+                    continue
+
+        def children_of(pid: int) -> list[int]:
+            return [child for child, par in parent.items() if par == pid]
+
     tree, frontier = {root}, [root]
     while frontier:
-        kids = _children(frontier.pop())
-        if kids is None:
-            break
-        for child in kids:
+        for child in children_of(frontier.pop()) or ():
             if child not in tree:
-                tree.add(child)
-                frontier.append(child)
-    else:
-        return tree
-    parent: dict[int, int] = {}
-    for entry in os.listdir("/proc"):
-        if entry.isdigit():
-            try:
-                with open(f"/proc/{entry}/stat") as fh:
-                    parent[int(entry)] = int(fh.read().rsplit(")", 1)[1].split()[1])
-            except (OSError, IndexError, ValueError):
-                continue
-    tree, frontier = {root}, [root]
-    while frontier:
-        p = frontier.pop()
-        for child, par in parent.items():
-            if par == p and child not in tree:
                 tree.add(child)
                 frontier.append(child)
     return tree
