@@ -41,7 +41,11 @@ IMPORT_TIME_PREFIXES = ("NUMBA_", "DASK_", "MPL", "MATPLOTLIB", "PYTHON", "OMP_"
 PRELOAD = ("numpy", "scipy.sparse", "scipy.sparse.linalg", "scipy.signal", "scipy.interpolate",
            "scipy.optimize", "scipy.stats", "xarray", "numba", "matplotlib.pyplot", "pydantic",
            "typer", "rich.console", "rich.progress", "skfem", "zarr", "dask", "dask.array",
-           "h5netcdf")
+           "h5netcdf",
+           # imported by geardyn.units, and by xarray (its duck-array check); and
+           # dask.distributed, which xarray imports on every to_netcdf where dask is installed
+           # (its scheduler check): 0.3-0.5 s of each command that writes or converts units
+           "pint", "distributed")
 #: geardyn's library modules, imported by the server too (they read no environment variable
 #: when imported, and create no console: ``geardyn.cli`` and its rich consoles, which read
 #: COLUMNS and the terminal when created, are imported by each child); measured 0.1-0.2 s of
@@ -230,6 +234,22 @@ def _exit_as_the_interpreter(request: dict) -> None:
         os._exit(code)
 
 
+def _numba_registries() -> None:
+    """numba's typing and lowering registries, which it loads on its first compile or cache
+    load in a process (``numba.cpython.charseq``, ``listobj``, ``numbers``, ``arraymath``, ...:
+    0.2-0.4 s of every command that runs a kernel), loaded once here. Nothing is compiled and
+    no thread is started (a fork after that is as after the imports)."""
+    import threading
+
+    try:
+        from numba.core.registry import cpu_target
+    except ImportError:
+        return
+    cpu_target.typing_context.refresh()
+    cpu_target.target_context.refresh()
+    assert threading.active_count() == 1, "no thread before fork"
+
+
 def _serve(req_fd: int, rep_fd: int) -> None:
     import importlib
 
@@ -240,6 +260,7 @@ def _serve(req_fd: int, rep_fd: int) -> None:
         except ImportError:  # an optional library missing: the child imports what it needs
             pass
     assert not [m for m in sys.modules if m.startswith("geardyn.cli")], "no console before fork"
+    _numba_registries()
     buf = b""
     while True:
         while b"\n" not in buf:

@@ -14,6 +14,10 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
 GEARDYN = [sys.executable, "-m", "geardyn"]
+# the ``dask`` console script of this interpreter's environment (found even when the venv is
+# not activated, i.e. its bin folder not on PATH)
+_here = Path(sys.executable).with_name("dask")
+DASK = str(_here) if _here.exists() else "dask"
 
 
 def env() -> dict[str, str]:
@@ -57,7 +61,7 @@ def dask_cluster(tmp: Path, n_workers: int = 2, timeout: float = 60.0) -> Iterat
     from distributed import Client
 
     sched_file = tmp / "scheduler.json"
-    procs = [start(["dask", "scheduler", "--host", "127.0.0.1", "--port", "0",
+    procs = [start([DASK, "scheduler", "--host", "127.0.0.1", "--port", "0",
                     "--no-dashboard", "--scheduler-file", str(sched_file)], tmp,
                    tmp / "scheduler.log")]
     try:
@@ -70,7 +74,7 @@ def dask_cluster(tmp: Path, n_workers: int = 2, timeout: float = 60.0) -> Iterat
         address = json.loads(sched_file.read_text())["address"]
         assert address.startswith("tcp://127.0.0.1:")
         for i in range(n_workers):
-            procs.append(start(["dask", "worker", address, "--nworkers", "1", "--nthreads", "1",
+            procs.append(start([DASK, "worker", address, "--nworkers", "1", "--nthreads", "1",
                                 "--host", "127.0.0.1", "--no-dashboard", "--name", f"w{i}",
                                 "--local-directory", str(tmp / f"w{i}")], tmp,
                                tmp / f"worker{i}.log"))
