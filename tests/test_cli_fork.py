@@ -9,6 +9,7 @@ import os
 import subprocess
 import sys
 
+import numpy as np
 import pytest
 
 from ._cli_fork import _forkable, run_geardyn
@@ -55,3 +56,29 @@ def test_import_time_variables_fall_back_to_a_subprocess():
     assert not _forkable({**os.environ, "NUMBA_DISABLE_JIT": "1"})
     assert not _forkable({**os.environ, "PYTHONHASHSEED": "1"})
     assert _forkable({**os.environ, "PYTHONPATH": "/somewhere", "GEARDYN_PROGRESS": "1"})
+
+
+@pytest.mark.slow
+def test_a_kernel_run_written_to_netcdf_is_the_same_as_from_a_fresh_interpreter(tmp_path):
+    """What the server loads before forking (numba's registries, pint, dask.distributed, which
+    xarray imports to write NetCDF) changes nothing a command computes or writes: a short
+    ``simulate`` (the compiled time-step kernel, units, a NetCDF record) forked and fresh give
+    the same exit code, output and variables, bit for bit."""
+    import xarray as xr
+
+    short = ["simulate", "--stiffness", "pem", "--force",
+             "--set", "simulation.settle_time=0.002 s", "--set", "simulation.record_time=0.004 s",
+             "--set", "stiffness.centre_distances=11", "--set", "stiffness.nodes_per_segment=8"]
+    env = {**os.environ, "COLUMNS": "72", "GEARDYN_PROGRESS": "0"}
+    forked = run_geardyn([*short, "--out", str(tmp_path / "forked.nc")], env=env, cwd=tmp_path,
+                         timeout=300)
+    fresh = subprocess.run([sys.executable, "-m", "geardyn", *short, "--out",
+                            str(tmp_path / "fresh.nc")], capture_output=True, text=True, env=env,
+                           cwd=tmp_path, timeout=300, stdin=subprocess.DEVNULL)
+    assert forked.returncode == fresh.returncode == 0, (forked.stderr, fresh.stderr)
+    assert forked.stdout.replace("forked.nc", "X") == fresh.stdout.replace("fresh.nc", "X")
+    with xr.open_dataset(tmp_path / "forked.nc") as a, xr.open_dataset(tmp_path / "fresh.nc") as b:
+        assert sorted(a.variables) == sorted(b.variables) and a.sizes["time"] > 10
+        for name in a.variables:
+            np.testing.assert_array_equal(a[name].values, b[name].values, err_msg=name)
+            assert a[name].attrs == b[name].attrs, name
