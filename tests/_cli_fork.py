@@ -3,7 +3,9 @@
 The suite runs the CLI a few hundred times; a fresh ``python -m geardyn`` spends 0.4-0.6 s of
 each on importing NumPy, SciPy, xarray, numba, matplotlib, scikit-fem, dask and zarr before
 geardyn starts (measured 2026-11-26: ``geardyn config validate`` 0.68 -> 0.22 s,
-``geardyn diagnose`` 0.75 -> 0.31 s, a short ``geardyn simulate`` 1.48 -> 0.91 s). Here a
+``geardyn diagnose`` 0.75 -> 0.31 s, a short ``geardyn simulate`` 1.48 -> 0.91 s; pint,
+``dask.distributed`` and numba's registries, which each command still loaded again, were added
+on 2026-11-27: four CLI-heavy test files 78 -> 60 s in one process). Here a
 server process imports those third-party libraries (and geardyn's library modules, not its CLI)
 once per test worker and *forks* one child per command line: the child is a separate process
 that imports geardyn's CLI itself (its consoles see the child's environment), runs its entry
