@@ -38,7 +38,7 @@ from .model import (
     static_equilibrium,
 )
 
-__all__ = ["simulate", "make_setup", "initial_state", "run_steps", "KernelSetup",
+__all__ = ["simulate", "integrate", "make_setup", "initial_state", "run_steps", "KernelSetup",
            "fixed_distance_arrays", "CHUNK_STEPS", "CITATIONS"]
 
 #: Steps per kernel call (progress is reported between calls).
@@ -526,6 +526,39 @@ def simulate(case, stiffness_map: StiffnessMap | None = None, *, model: str | No
         from ..stiffness import build_map
 
         stiffness_map = build_map(case, cracked=cracked)
+    status, fail, record = integrate(case, stiffness_map, which, cracked=cracked,
+                                     progress=progress)
+    if status != K.OK:
+        raise_with_partial(status, fail, which, record.static, stiffness_map, record)
+    return record(True)
+
+
+def integrate(case, stiffness_map: StiffnessMap, which: str, *, cracked: bool = True,
+              progress: Callable[[int, int], None] | None = None
+              ) -> tuple[int, np.ndarray, Callable]:
+    """The time steps of :func:`simulate` for checked arguments, without building the record.
+
+    Parameters
+    ----------
+    case : geardyn.config.Case
+        A checked case (:func:`simulate` checks it first).
+    stiffness_map : StiffnessMap
+    which : {"I", "I-static", "II"}
+    cracked : bool
+        Which load family (``stiffness.fe.torques``) to build.
+    progress : callable, optional
+        As for :func:`simulate`.
+
+    Returns
+    -------
+    status : int
+        The kernel's status (:data:`geardyn.dynamics._kernel.OK` when every step ran).
+    fail : ndarray
+        The kernel's failure details.
+    record : callable
+        ``record(complete) -> xarray.Dataset``: the record of the steps run (xarray imported
+        only when called); ``record.static`` is the static state the run started from.
+    """
     from ..stiffness import build_load_family
 
     family = build_load_family(case, cracked=cracked)  # None unless stiffness.fe.torques
@@ -550,10 +583,9 @@ def simulate(case, stiffness_map: StiffnessMap | None = None, *, model: str | No
         return _dataset(case, dyn, stiffness_map, which, static, setup, out[:rows[0]], n_settle,
                         decim, complete=complete)
 
+    record.static = static
     status, fail = drive_chunks(step, ist, n_last, progress=progress)
-    if status != K.OK:
-        raise_with_partial(status, fail, which, static, stiffness_map, record)
-    return record(True)
+    return status, fail, record
 
 
 def check_arguments(case, stiffness_map, model) -> str:

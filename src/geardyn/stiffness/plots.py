@@ -1,8 +1,11 @@
 """Figures of stiffness maps: analogues of Xue & Howard (2018) Figs. 5 and 6.
 
 Every function takes :class:`~geardyn.stiffness.map.StiffnessMap` objects, whatever method made
-them (PEM, FE, a user's table), and returns a :class:`matplotlib.figure.Figure` without touching
-pyplot's global state.
+them (PEM, FE, a user's table). The ``fig_*`` functions return a
+:class:`matplotlib.figure.Figure` without touching pyplot's global state; each is
+:func:`geardyn.line_figure.draw_line_figure` of its ``*_curves`` function, which evaluates the
+maps and returns the curves as plain arrays and text (what ``geardyn run`` hands its figure
+process, which then draws without the map code).
 
 Labels follow the paper: ``K00``, ``K05``, ``K10`` for the centre distance changes 0, 0.5 and
 1.0 mm (Fig. 5a), ``L00``... for the load sharing ratios (Fig. 5b), and ``KC005`` / ``KC105`` for
@@ -19,10 +22,11 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from ..errors import InputError
+from ..line_figure import draw_line_figure
 from .map import StiffnessMap
 
 __all__ = ["pair_load_share", "crack_angle", "fig_stiffness", "fig_load_sharing", "fig_crack",
-           "dd_label"]
+           "dd_label", "stiffness_curves", "load_sharing_curves", "crack_curves"]
 
 DEFAULT_DD = (0.0, 0.5e-3, 1.0e-3)
 
@@ -30,14 +34,6 @@ DEFAULT_DD = (0.0, 0.5e-3, 1.0e-3)
 def dd_label(prefix: str, dd: float) -> str:
     """The paper's curve label: ``K`` + tenths of a millimetre, e.g. ``K05`` for 0.5 mm."""
     return f"{prefix}{round(dd * 1e4):02d}"
-
-
-def _legend_below(fig: Figure, ax, ncols: int = 3) -> None:
-    """The legend under the axes, outside the data (constrained layout makes room)."""
-    handles, labels = ax.get_legend_handles_labels()
-    if handles:
-        fig.legend(handles, labels, loc="outside lower center", ncols=min(ncols, len(handles)),
-                   fontsize="small", frameon=False)
 
 
 def _covered(m: StiffnessMap, dds: Sequence[float]) -> list[float]:
@@ -107,6 +103,24 @@ def _crack_depth(m: StiffnessMap) -> float | None:
         return None
 
 
+def stiffness_curves(m: StiffnessMap, dds: Sequence[float] = DEFAULT_DD, *,
+                     theta_range: tuple[float, float] | None = None, n: int = 2000) -> dict:
+    """The curves of :func:`fig_stiffness` as a plain specification
+    (:mod:`geardyn.line_figure`): ``K_t`` [N m/rad] against the pinion angle [deg]."""
+    tm = m.mesh_angle
+    lo, hi = theta_range or (-tm, 2 * tm)
+    th = np.linspace(lo, hi, n)
+    lines = [{"y": m.torsional(th, d),
+              "label": f"{dd_label('K', d)} ($\\Delta d$ = {d * 1e3:g} mm)"}
+             for d in _covered(m, dds)]
+    return {"x": np.degrees(th), "lines": lines,
+            "xlabel": r"pinion rolling angle $\theta$ [deg]",
+            "ylabel": r"combined torsional mesh stiffness $K_t$ [N m/rad]",
+            "title": f"Mesh stiffness for several centre distances "
+                     f"({m.attrs.get('method', '?')})",
+            "legend_columns": 3, "figsize": (7.5, 4.8)}
+
+
 def fig_stiffness(m: StiffnessMap, dds: Sequence[float] = DEFAULT_DD, *,
                   theta_range: tuple[float, float] | None = None, n: int = 2000) -> Figure:
     """Fig. 5a analogue: combined torsional mesh stiffness against pinion angle for several
@@ -122,20 +136,24 @@ def fig_stiffness(m: StiffnessMap, dds: Sequence[float] = DEFAULT_DD, *,
     n : int
         Points per curve.
     """
+    return draw_line_figure(stiffness_curves(m, dds, theta_range=theta_range, n=n))
+
+
+def load_sharing_curves(m: StiffnessMap, dds: Sequence[float] = DEFAULT_DD, *,
+                        pinion_tooth: int = 0, n: int = 2000) -> dict:
+    """The curves of :func:`fig_load_sharing` as a plain specification
+    (:mod:`geardyn.line_figure`): the load sharing ratio [-] against the pinion angle [deg]."""
     tm = m.mesh_angle
-    lo, hi = theta_range or (-tm, 2 * tm)
-    th = np.linspace(lo, hi, n)
-    fig = Figure(figsize=(7.5, 4.8), layout="constrained")
-    ax = fig.add_subplot()
-    for d in _covered(m, dds):
-        ax.plot(np.degrees(th), m.torsional(th, d), label=f"{dd_label('K', d)} "
-                f"($\\Delta d$ = {d * 1e3:g} mm)")
-    ax.set_xlabel(r"pinion rolling angle $\theta$ [deg]")
-    ax.set_ylabel(r"combined torsional mesh stiffness $K_t$ [N m/rad]")
-    ax.set_title(f"Mesh stiffness for several centre distances ({m.attrs.get('method', '?')})")
-    ax.grid(True, alpha=0.3)
-    _legend_below(fig, ax)
-    return fig
+    t0 = pinion_tooth * tm
+    th = np.linspace(t0 - 1.5 * tm, t0 + 1.5 * tm, n)
+    lines = [{"y": pair_load_share(m, th, d, pinion_tooth),
+              "label": f"{dd_label('L', d)} ($\\Delta d$ = {d * 1e3:g} mm)"}
+             for d in _covered(m, dds)]
+    return {"x": np.degrees(th), "lines": lines,
+            "xlabel": r"pinion rolling angle $\theta$ [deg]",
+            "ylabel": f"load sharing ratio of pinion tooth {pinion_tooth}'s pair [-]",
+            "ylim": (-0.05, 1.05), "title": "Load sharing ratio through one engagement",
+            "legend_columns": 3, "figsize": (7.5, 4.8)}
 
 
 def fig_load_sharing(m: StiffnessMap, dds: Sequence[float] = DEFAULT_DD, *,
@@ -154,22 +172,7 @@ def fig_load_sharing(m: StiffnessMap, dds: Sequence[float] = DEFAULT_DD, *,
     n : int
         Points per curve.
     """
-    tm = m.mesh_angle
-    t0 = pinion_tooth * tm
-    th = np.linspace(t0 - 1.5 * tm, t0 + 1.5 * tm, n)
-    fig = Figure(figsize=(7.5, 4.8), layout="constrained")
-    ax = fig.add_subplot()
-    for d in _covered(m, dds):
-        ax.plot(np.degrees(th), pair_load_share(m, th, d, pinion_tooth),
-                label=f"{dd_label('L', d)} ($\\Delta d$ = {d * 1e3:g} mm)")
-    ax.set_xlabel(r"pinion rolling angle $\theta$ [deg]")
-    ax.set_ylabel(f"load sharing ratio of pinion tooth {pinion_tooth}'s pair [-]")
-    ax.set_ylim(-0.05, 1.05)
-    ax.set_title("Load sharing ratio through one engagement")
-    ax.grid(True, alpha=0.3)
-    _legend_below(fig, ax)
-    return fig
-
+    return draw_line_figure(load_sharing_curves(m, dds, pinion_tooth=pinion_tooth, n=n))
 
 
 def _on_gear(m: StiffnessMap) -> bool:
@@ -179,6 +182,37 @@ def _on_gear(m: StiffnessMap) -> bool:
     if isinstance(p.get("crack"), dict):
         gears.append(p["crack"].get("gear"))
     return bool(gears) and all(g == "gear" for g in gears)
+
+
+def crack_curves(healthy: StiffnessMap, cracked: StiffnessMap,
+                 dds: Sequence[float] = (0.0, 1.0e-3), *, theta_center: float | None = None,
+                 n: int = 2000, faulty: str = "cracked") -> dict:
+    """The curves of :func:`fig_crack` as a plain specification (:mod:`geardyn.line_figure`):
+    ``K_t`` [N m/rad] of the healthy and the faulty pair against the pinion angle [deg]."""
+    tm = healthy.mesh_angle
+    dds = _covered(cracked, dds)
+    if theta_center is None:
+        theta_center = crack_angle(healthy, cracked, dds[0])
+    # show the cycles of the cracked tooth's engagement and one cycle either side
+    th = np.linspace(theta_center - 2 * tm, theta_center + 2 * tm, n)
+    depth = _crack_depth(cracked)
+    dlab = f"{round(depth * 1e3):02d}" if depth is not None else ""
+    lines = [{"y": healthy.torsional(th, 0.0), "color": "0.3",
+              "label": "K00 (healthy, " r"$\Delta d$ = 0 mm)"}]
+    for d in dds:
+        name = f"KC{round(d * 1e3)}{dlab}" if math.isclose(d * 1e3, round(d * 1e3),
+                                                            abs_tol=1e-9) else "KC"
+        extra = f", {depth * 1e3:g} mm crack" if depth is not None else ""
+        lines.append({"y": cracked.torsional(th, d),
+                      "label": f"{name} ({faulty}, $\\Delta d$ = {d * 1e3:g} mm{extra})"})
+    where = ", fault on the gear" if _on_gear(cracked) else ""
+    return {"x": np.degrees(th), "lines": lines,
+            "xlabel": r"pinion rolling angle $\theta$ [deg]",
+            "ylabel": r"combined torsional mesh stiffness $K_t$ [N m/rad]",
+            "title": f"Healthy and {faulty} mesh stiffness ({cracked.attrs.get('method', '?')}"
+                     f"{where})",
+            "legend_columns": 2, "figsize": (7.5, 4.8)}
+
 
 def fig_crack(healthy: StiffnessMap, cracked: StiffnessMap,
               dds: Sequence[float] = (0.0, 1.0e-3), *, theta_center: float | None = None,
@@ -199,29 +233,5 @@ def fig_crack(healthy: StiffnessMap, cracked: StiffnessMap,
         The legend's and title's word for the faulty pair: "cracked", or "faulty" where the
         map holds other faults besides (or instead of) the crack.
     """
-    tm = healthy.mesh_angle
-    dds = _covered(cracked, dds)
-    if theta_center is None:
-        theta_center = crack_angle(healthy, cracked, dds[0])
-    # show the cycles of the cracked tooth's engagement and one cycle either side
-    th = np.linspace(theta_center - 2 * tm, theta_center + 2 * tm, n)
-    depth = _crack_depth(cracked)
-    dlab = f"{round(depth * 1e3):02d}" if depth is not None else ""
-    fig = Figure(figsize=(7.5, 4.8), layout="constrained")
-    ax = fig.add_subplot()
-    ax.plot(np.degrees(th), healthy.torsional(th, 0.0), color="0.3", label="K00 (healthy, "
-            r"$\Delta d$ = 0 mm)")
-    for d in dds:
-        name = f"KC{round(d * 1e3)}{dlab}" if math.isclose(d * 1e3, round(d * 1e3),
-                                                            abs_tol=1e-9) else "KC"
-        extra = f", {depth * 1e3:g} mm crack" if depth is not None else ""
-        ax.plot(np.degrees(th), cracked.torsional(th, d),
-                label=f"{name} ({faulty}, $\\Delta d$ = {d * 1e3:g} mm{extra})")
-    ax.set_xlabel(r"pinion rolling angle $\theta$ [deg]")
-    ax.set_ylabel(r"combined torsional mesh stiffness $K_t$ [N m/rad]")
-    where = ", fault on the gear" if _on_gear(cracked) else ""
-    ax.set_title(f"Healthy and {faulty} mesh stiffness ({cracked.attrs.get('method', '?')}"
-                 f"{where})")
-    ax.grid(True, alpha=0.3)
-    _legend_below(fig, ax, ncols=2)
-    return fig
+    return draw_line_figure(crack_curves(healthy, cracked, dds, theta_center=theta_center, n=n,
+                                         faulty=faulty))

@@ -171,10 +171,13 @@ def stiffness_stage(case: Case, out: Path, result: StudyResult) -> None:
 
     from ..stiffness import build_map
 
-    # drawn only on a figure-cache miss: importing the plots imports matplotlib (issue 16)
-    fig_stiffness, fig_load_sharing, fig_crack = (
+    # drawn only on a figure-cache miss: importing the plots imports matplotlib (issue 16);
+    # the curves are evaluated here, where the maps and numba are, and drawn from plain arrays
+    # (a figure process then draws them without importing the maps' code and numba)
+    stiffness_curves, load_sharing_curves, crack_curves = (
         _ImportedOnCall("geardyn.stiffness.plots", name)
-        for name in ("fig_stiffness", "fig_load_sharing", "fig_crack"))
+        for name in ("stiffness_curves", "load_sharing_curves", "crack_curves"))
+    draw = _ImportedOnCall("geardyn.line_figure", "draw_line_figure")
     map_case = _map_case(case, result.quick)
     if map_case is not case:
         what = [f"{map_case.stiffness.centre_distances} centre distances"]
@@ -199,13 +202,16 @@ def stiffness_stage(case: Case, out: Path, result: StudyResult) -> None:
             if text not in result.notes:
                 result.notes.append(text)
     result.maps = {"healthy": healthy, "cracked": cracked}
-    from .paper_cache import write_output
+    from .paper_cache import fingerprint, write_output
+    from .paper_result import Deferred
 
     for state, m in result.maps.items():  # the bytes from the cache when an earlier run wrote them
         write_output(out / f"stiffness_{state}.nc", "stiffness map", m, "StiffnessMap.to_netcdf",
                      m.to_netcdf)
-    result.figures.cached("fig5_stiffness", fig_stiffness, healthy)
-    result.figures.cached("fig5_load_sharing", fig_load_sharing, healthy)
+    result.figures.cached("fig5_stiffness", draw, Deferred(
+        fingerprint("fig5_stiffness curves", healthy), lambda: stiffness_curves(healthy)))
+    result.figures.cached("fig5_load_sharing", draw, Deferred(
+        fingerprint("fig5_load_sharing curves", healthy), lambda: load_sharing_curves(healthy)))
     if case.stiffness.method == "fe":
         # imported only to draw: the FE package takes 0.2 s to import (issue 16)
         plot_mesh = _ImportedOnCall("geardyn.stiffness.fe", "plot_mesh")
@@ -220,8 +226,10 @@ def stiffness_stage(case: Case, out: Path, result: StudyResult) -> None:
     dd_op = dd_op if cracked.covers(dd_op) else 0.0
     numbers = map_numbers(healthy, cracked, cracks, dd_op)
     if cracks:
-        result.figures.cached("fig6_crack", fig_crack, healthy, cracked,
-                              faulty=faulty_words(case)[0])
+        faulty = faulty_words(case)[0]
+        result.figures.cached("fig6_crack", draw, Deferred(
+            fingerprint("fig6_crack curves", healthy, cracked, faulty),
+            lambda: crack_curves(healthy, cracked, faulty=faulty)))
         result.summary["crack_angle_in_stiffness_deg"] = math.degrees(numbers["crack_angle_op"])
         result.summary["crack_angle_in_stiffness_at_mm"] = dd_op * 1e3
         result.crack_angle_rad = numbers["crack_angle_0"]
