@@ -219,3 +219,30 @@ def run_measured(cmd: list[str], env: dict, *, interval: float = 0.05, pss_every
             err.seek(0)
             raise RuntimeError(f"{' '.join(cmd)} failed:\n{err.read().decode()}")
     return wall, peak[0] / 1024.0, usage.ru_maxrss / 1024.0, peak[1] / 1024.0
+
+
+def machine() -> str:
+    """CPU model and logical cores of this machine (Linux /proc/cpuinfo; platform otherwise)."""
+    import os
+    import platform
+    from pathlib import Path
+
+    name = platform.processor() or platform.machine()
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                name = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    return f"{name}, {os.cpu_count()} logical cores, Python {platform.python_version()}"
+
+
+def load_average() -> float:
+    """The 1-minute load average (NaN where the system has none)."""
+    import os
+
+    try:
+        return os.getloadavg()[0]
+    except OSError:  # pragma: no cover - not on Linux
+        return float("nan")

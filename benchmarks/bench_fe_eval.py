@@ -14,25 +14,17 @@ the 1-minute load average before and after the timing.
 
 from __future__ import annotations
 
-import os
 import sys
 import time
 
 import numpy as np
 
 import geardyn
-from _common import Row
-
-
-def _load() -> float:
-    try:
-        return os.getloadavg()[0]
-    except OSError:  # pragma: no cover - not on Linux
-        return float("nan")
+from _common import Row, machine
+from _common import load_average as _load
 
 
 def run(quick: bool = False) -> list[Row]:
-    from bench_measure import machine
     from geardyn.stiffness import centre_distance_grid
     from geardyn.stiffness.fe import FEStiffness
     from geardyn.stiffness.map import StiffnessMap

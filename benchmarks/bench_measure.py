@@ -25,34 +25,10 @@ from pathlib import Path
 
 import numpy as np
 
-from _common import Row, best_time
+from _common import Row, best_time, machine
+from _common import load_average as _load
 
 ROOT = Path(__file__).resolve().parents[1]
-
-
-def machine() -> str:
-    """CPU model and logical cores of this machine (Linux /proc/cpuinfo; platform otherwise)."""
-    import os
-    import platform
-
-    name = platform.processor() or platform.machine()
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                name = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    return f"{name}, {os.cpu_count()} logical cores, Python {platform.python_version()}"
-
-
-def _load() -> float:
-    import os
-
-    try:
-        return os.getloadavg()[0]
-    except OSError:  # pragma: no cover - not on Linux
-        return float("nan")
 
 
 def run(quick: bool) -> list[Row]:

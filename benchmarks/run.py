@@ -20,7 +20,7 @@ import traceback
 HERE = pathlib.Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
-from _common import Row  # noqa: E402
+from _common import Row, load_average, machine  # noqa: E402
 
 
 def _load(path: pathlib.Path):
@@ -37,10 +37,18 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--quick", action="store_true", help="smaller problem sizes")
     args = ap.parse_args(argv)
 
+    import datetime
+
     from rich.console import Console
     from rich.table import Table
 
     console = Console()
+    started = datetime.datetime.now(datetime.UTC)
+    load0 = load_average()
+    # the machine, its load and the date with every table (issue 16.8: read the ratios against
+    # the same run's baselines; the absolute times depend on both)
+    console.print(f"{started:%Y-%m-%d %H:%M} UTC; {machine()}; 1-min load average "
+                  f"{load0:.2f} at the start", highlight=False)
     files = sorted(HERE.glob("bench_*.py"))
     if args.only:
         files = [f for f in files if any(s in f.stem for s in args.only)]
@@ -63,6 +71,8 @@ def main(argv: list[str] | None = None) -> int:
             if met and r.margin:  # by how much it is met or missed (issue 16, "must show")
                 met = f"{met}, {r.margin}"
             table.add_row(r.name, f"{r.value:.4g} {r.unit}", base, ratio, r.target, met)
+    table.caption = (f"{started:%Y-%m-%d %H:%M} UTC; {machine()}; 1-min load average "
+                     f"{load0:.2f} at the start, {load_average():.2f} at the end")
     console.print(table)
     return 1 if failed else 0
 
