@@ -30,6 +30,10 @@ __all__ = ["pair_load_share", "crack_angle", "fig_stiffness", "fig_load_sharing"
 
 DEFAULT_DD = (0.0, 0.5e-3, 1.0e-3)
 
+#: Axis labels of the figures against the pinion angle.
+_THETA_LABEL = r"pinion rolling angle $\theta$ [deg]"
+_KT_LABEL = r"combined torsional mesh stiffness $K_t$ [N m/rad]"
+
 
 def dd_label(prefix: str, dd: float) -> str:
     """The paper's curve label: ``K`` + tenths of a millimetre, e.g. ``K05`` for 0.5 mm."""
@@ -114,8 +118,7 @@ def stiffness_curves(m: StiffnessMap, dds: Sequence[float] = DEFAULT_DD, *,
               "label": f"{dd_label('K', d)} ($\\Delta d$ = {d * 1e3:g} mm)"}
              for d in _covered(m, dds)]
     return {"x": np.degrees(th), "lines": lines,
-            "xlabel": r"pinion rolling angle $\theta$ [deg]",
-            "ylabel": r"combined torsional mesh stiffness $K_t$ [N m/rad]",
+            "xlabel": _THETA_LABEL, "ylabel": _KT_LABEL,
             "title": f"Mesh stiffness for several centre distances "
                      f"({m.attrs.get('method', '?')})",
             "legend_columns": 3, "figsize": (7.5, 4.8)}
@@ -150,7 +153,7 @@ def load_sharing_curves(m: StiffnessMap, dds: Sequence[float] = DEFAULT_DD, *,
               "label": f"{dd_label('L', d)} ($\\Delta d$ = {d * 1e3:g} mm)"}
              for d in _covered(m, dds)]
     return {"x": np.degrees(th), "lines": lines,
-            "xlabel": r"pinion rolling angle $\theta$ [deg]",
+            "xlabel": _THETA_LABEL,
             "ylabel": f"load sharing ratio of pinion tooth {pinion_tooth}'s pair [-]",
             "ylim": (-0.05, 1.05), "title": "Load sharing ratio through one engagement",
             "legend_columns": 3, "figsize": (7.5, 4.8)}
@@ -207,8 +210,7 @@ def crack_curves(healthy: StiffnessMap, cracked: StiffnessMap,
                       "label": f"{name} ({faulty}, $\\Delta d$ = {d * 1e3:g} mm{extra})"})
     where = ", fault on the gear" if _on_gear(cracked) else ""
     return {"x": np.degrees(th), "lines": lines,
-            "xlabel": r"pinion rolling angle $\theta$ [deg]",
-            "ylabel": r"combined torsional mesh stiffness $K_t$ [N m/rad]",
+            "xlabel": _THETA_LABEL, "ylabel": _KT_LABEL,
             "title": f"Healthy and {faulty} mesh stiffness ({cracked.attrs.get('method', '?')}"
                      f"{where})",
             "legend_columns": 2, "figsize": (7.5, 4.8)}
