@@ -3,9 +3,9 @@
 The stiffness figures (:mod:`geardyn.stiffness.plots`, the analogues of Xue & Howard (2018)
 Figs. 5 and 6) evaluate their maps where the maps are and hand this module the curves. Drawing
 them needs matplotlib and numpy only: the process that draws a run's report figures
-(:mod:`geardyn.studies.figure_process`) then neither imports the map code and numba nor
-initialises numba's compiler to evaluate a map, which cost it about 0.9 s and 120 MB on a first
-``geardyn run --quick`` (measured 2026-11-27 on the 2-core machine).
+(:mod:`geardyn.studies.figure_process`) then neither imports the map code and numba (0.3 s,
+56 MB) nor loads numba's compiled map look-up to evaluate a map (0.3 s, 50 MB; measured
+2026-11-27 on the 2-core machine).
 
 A curves specification is a plain ``dict`` (it pickles without geardyn's classes):
 
