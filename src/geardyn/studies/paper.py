@@ -53,6 +53,7 @@ from .paper_values import (
     PAPER_VALUES,
     SIGNAL_KEYS,
     case_differences,
+    fault_word,
     faulty_words,
 )
 
@@ -225,11 +226,14 @@ def stiffness_stage(case: Case, out: Path, result: StudyResult) -> None:
     dd_op = result.summary.get("static", {}).get("centre_distance_change_mm", 0.0) * 1e-3
     dd_op = dd_op if cracked.covers(dd_op) else 0.0
     numbers = map_numbers(healthy, cracked, cracks, dd_op)
-    if cracks:
+    if fault_word(case):
+        # the Fig. 6 analogue for any fault (a spall, breakage, wear...), not only a crack:
+        # centred where the faulty map falls furthest below the healthy one
         faulty = faulty_words(case)[0]
         result.figures.cached("fig6_crack", draw, Deferred(
             fingerprint("fig6_crack curves", healthy, cracked, faulty),
             lambda: crack_curves(healthy, cracked, faulty=faulty)))
+    if cracks:
         result.summary["crack_angle_in_stiffness_deg"] = math.degrees(numbers["crack_angle_op"])
         result.summary["crack_angle_in_stiffness_at_mm"] = dd_op * 1e3
         result.crack_angle_rad = numbers["crack_angle_0"]
