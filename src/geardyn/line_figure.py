@@ -12,7 +12,7 @@ A curves specification is a plain ``dict`` (it pickles without geardyn's classes
 ``x`` : ndarray
     Abscissa of every line (unit in ``xlabel``).
 ``lines`` : list of dict
-    Each ``{"y": ndarray, "label": str}`` plus optional matplotlib line keywords (``color``).
+    Each ``{"y": ndarray, "label": str}``, optionally with a matplotlib ``"color"``.
 ``xlabel``, ``ylabel``, ``title`` : str
 ``ylim`` : (float, float) or None
 ``legend_columns`` : int
@@ -27,8 +27,6 @@ from collections.abc import Mapping
 
 __all__ = ["draw_line_figure"]
 
-#: Line keywords a specification may give besides ``y`` and ``label``.
-_STYLE_KEYS = ("color", "ls", "lw")
 
 
 def draw_line_figure(spec: Mapping):
@@ -50,7 +48,7 @@ def draw_line_figure(spec: Mapping):
     fig = Figure(figsize=tuple(spec.get("figsize", (7.5, 4.8))), layout="constrained")
     ax = fig.add_subplot()
     for line in spec["lines"]:
-        style = {k: line[k] for k in _STYLE_KEYS if k in line}
+        style = {"color": line["color"]} if "color" in line else {}
         ax.plot(spec["x"], line["y"], label=line["label"], **style)
     ax.set_xlabel(spec["xlabel"])
     ax.set_ylabel(spec["ylabel"])

@@ -526,16 +526,16 @@ def simulate(case, stiffness_map: StiffnessMap | None = None, *, model: str | No
         from ..stiffness import build_map
 
         stiffness_map = build_map(case, cracked=cracked)
-    status, fail, record = integrate(case, stiffness_map, which, cracked=cracked,
-                                     progress=progress)
+    status, fail, static, record = integrate(case, stiffness_map, which, cracked=cracked,
+                                             progress=progress)
     if status != K.OK:
-        raise_with_partial(status, fail, which, record.static, stiffness_map, record)
+        raise_with_partial(status, fail, which, static, stiffness_map, record)
     return record(True)
 
 
 def integrate(case, stiffness_map: StiffnessMap, which: str, *, cracked: bool = True,
               progress: Callable[[int, int], None] | None = None
-              ) -> tuple[int, np.ndarray, Callable]:
+              ) -> tuple[int, np.ndarray, StaticState, Callable]:
     """The time steps of :func:`simulate` for checked arguments, without building the record.
 
     Parameters
@@ -555,9 +555,11 @@ def integrate(case, stiffness_map: StiffnessMap, which: str, *, cracked: bool = 
         The kernel's status (:data:`geardyn.dynamics._kernel.OK` when every step ran).
     fail : ndarray
         The kernel's failure details.
+    static : StaticState
+        The static state the run started from.
     record : callable
         ``record(complete) -> xarray.Dataset``: the record of the steps run (xarray imported
-        only when called); ``record.static`` is the static state the run started from.
+        only when called).
     """
     from ..stiffness import build_load_family
 
@@ -583,9 +585,8 @@ def integrate(case, stiffness_map: StiffnessMap, which: str, *, cracked: bool = 
         return _dataset(case, dyn, stiffness_map, which, static, setup, out[:rows[0]], n_settle,
                         decim, complete=complete)
 
-    record.static = static
     status, fail = drive_chunks(step, ist, n_last, progress=progress)
-    return status, fail, record
+    return status, fail, static, record
 
 
 def check_arguments(case, stiffness_map, model) -> str:
