@@ -377,3 +377,91 @@ def test_a_figure_another_store_has_cached_meanwhile_is_read_from_the_cache(tmp_
     assert not c.process.started and isinstance(_raw(c, "f"), RenderedFigure)
     assert [(r["kind"], r["hit"]) for r in lookups] == [("figure", True)]
     assert c["f"].png == png
+
+
+def draw_slow_here(y, here: int, *, title="t"):
+    """:func:`draw`, a second slower in the process ``here`` (the test's) than in the worker."""
+    import time
+
+    if os.getpid() == here:
+        time.sleep(1.0)
+    return draw(y, title=title)
+
+
+def test_at_finish_the_process_gets_one_figure_at_a_time(monkeypatch):
+    """While ``finish`` draws the held figures here, the process is sent the next figure only
+    once it has drawn the last (:data:`IN_FLIGHT_AT_FINISH`): no figure waits in its queue
+    while this process, out of figures, waits for it. Each figure takes a second longer here,
+    so the worker finishes its two in flight while this process draws; with the window left at
+    :data:`IN_FLIGHT`, the first of them drawn lets another go at once."""
+    monkeypatch.setenv("GEARDYN_NO_CACHE", "1")
+    y = np.linspace(0.0, 1.0, 30)
+    store = FigureStore(FigureProcess())
+    store.cached("warm", draw, y, title="warm")
+    store["warm"]                             # the worker is up and has drawn a figure
+    sent_at: list = []
+    submit = store.process.submit
+
+    def counting_submit(*args, **kwargs):
+        sent_at.append(store._in_flight)       # (called under the store's lock)
+        return submit(*args, **kwargs)
+
+    store.process.submit = counting_submit
+    titles = TITLES[:6]
+    for title in titles:
+        store.cached(title, draw_slow_here, y, os.getpid(), title=title)
+    assert sent_at == [0, 1] and len(store._held) == 4
+    del sent_at[:]
+    store.finish()
+    assert sent_at and set(sent_at) == {0}, sent_at   # sent to the worker, one at a time
+    for title in titles:
+        assert store[title].png == _expected(y, title)
+
+
+def test_start_early_starts_the_process_at_the_first_poll_it_may(monkeypatch):
+    """``start_early`` lets ``poll`` (each progress report of a study) start the worker as
+    soon as ``ready()`` allows, with the held figures or, with none, on its imports; without
+    it, or while ``ready()`` says no, nothing starts; ``StudyResult.emit`` polls."""
+    import time
+
+    from geardyn.studies.paper_result import StudyResult
+
+    monkeypatch.setenv("GEARDYN_NO_CACHE", "1")
+    gate = {"open": False}
+    store = FigureStore(FigureProcess(ready=lambda: gate["open"]))
+    gate["open"] = True
+    store.poll()
+    assert not store.process.started            # not asked to start early
+    gate["open"] = False
+    store.start_early()
+    store.poll()
+    assert not store.process.started            # not ready
+    gate["open"] = True
+    store.poll()
+    assert not store.process.started            # asked again 50 ms later at the soonest
+    time.sleep(0.06)
+    result = StudyResult(out=None, figures=store)
+    result.emit("stage", 0, 1)                  # a progress report polls
+    assert store.process.started
+    started = store.process._pool
+    store.poll()
+    assert store.process._pool is started       # one worker
+    y = np.linspace(0.0, 1.0, 30)
+    store.cached("f", draw, y, title="f")
+    assert store["f"].png == _expected(y, "f")
+    store.finish()
+
+    held = FigureStore(FigureProcess(ready=lambda: gate["open"]))
+    gate["open"] = False
+    held.cached("h", draw, y, title="h")        # held: not ready
+    held.start_early()
+    gate["open"] = True
+    held.poll()
+    assert held.process.started and held._in_flight == 1 and not held._held
+    assert held["h"].png == _expected(y, "h")
+    held.finish()
+
+    none = FigureStore()                        # no figure process: nothing to start
+    none.start_early()
+    none.poll()
+    assert none.process is None

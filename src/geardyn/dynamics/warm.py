@@ -13,6 +13,13 @@ process that calls the kernel before the compiled code is on disk compiles it it
 same result. The call runs the steps only (:func:`geardyn.dynamics.newmark.integrate`): no
 record, so the compiling process imports neither xarray nor the PEM code (0.9 s of a first
 ``geardyn run --quick``, measured 2026-11-27).
+
+It then compiles the resampling kernel of the time-synchronous average
+(:func:`geardyn.diagnostics.tsa.tsa`) on a four-revolution sine: every diagnosis of a run
+calls it, and the first run's first process compiled it itself, 0.45 s before its diagnostics
+stage (``py-spy`` of a first ``geardyn run --quick``, 2026-11-27), when the compiling process
+had ended seconds earlier. Its argument types are those of every call (float64 arrays, C order:
+:func:`~geardyn.diagnostics.tsa.tsa` makes them so), whatever the signal count and length.
 """
 
 from __future__ import annotations
@@ -23,7 +30,8 @@ __all__ = ["compile_kernels", "kernels_compiled"]
 
 
 def compile_kernels() -> float:
-    """Compile (or load from numba's cache) the 6-DOF time-step kernel.
+    """Compile (or load from numba's cache) the 6-DOF time-step kernel, then the TSA's
+    resampling kernel.
 
     Returns
     -------
@@ -46,7 +54,20 @@ def compile_kernels() -> float:
     stiffness_map = StiffnessMap.from_table(pair, theta, np.full((3, theta.size), 4.0e8),
                                             dd=centre_distance_grid(case), n_seg=8)
     integrate(case, stiffness_map, "II", cracked=False)
+    _compile_tsa()
     return time.perf_counter() - t0
+
+
+def _compile_tsa() -> None:
+    """A TSA of two signals over four revolutions with the numba kernel (the default engine):
+    the signature every diagnosis uses, compiled or loaded from numba's cache."""
+    import numpy as np
+
+    from ..diagnostics.tsa import tsa
+
+    angle = np.linspace(0.0, 8.0 * np.pi, 257)
+    x = np.stack([np.sin(angle), np.cos(3.0 * angle)])
+    tsa(x, angle=angle, samples_per_rev=16)
 
 
 def kernels_compiled() -> bool:

@@ -21,7 +21,10 @@ It costs memory: a second interpreter with matplotlib, xarray and geardyn import
 everything in one process), not from a daemon process (a pool's worker may not have children),
 and it starts only when ``ready()`` says so: the study waits until its other background
 processes (the FE bodies, the kernel compiler) have ended, so that no more than two processes
-are alive at once; figures handed over before then are held and sent when it starts.
+are alive at once; figures handed over before then are held and sent when it starts. The study
+asks again at each progress report (:meth:`.paper_result.FigureStore.poll`), so the worker
+starts, and imports matplotlib (:meth:`FigureProcess.warm_up`), as soon as they have ended
+rather than at the next figure.
 """
 
 from __future__ import annotations
@@ -66,6 +69,14 @@ def _draw_pickled(payload: bytes) -> bytes:
 
     draw, args, kwargs = pickle.loads(payload)
     return draw_png(draw, args, kwargs)
+
+
+def _warm_up() -> None:
+    """In the worker: import what drawing the report's figures imports (matplotlib, the figure
+    modules), before the first figure comes."""
+    import matplotlib.pyplot  # noqa: F401
+
+    from . import paper_figures, paper_result  # noqa: F401
 
 
 def _worker_init() -> None:
@@ -143,6 +154,25 @@ class FigureProcess:
 
     def _start_with(self, payload: bytes):
         """Create the pool and submit the first figure (which spawns the worker)."""
+        return self._start(_draw_pickled, payload)
+
+    def warm_up(self):
+        """Start the worker (if ``ready()`` allows and it has not started) on
+        :func:`_warm_up`, its imports, so that it is ready when the first figure comes.
+
+        Returns
+        -------
+        concurrent.futures.Future or None
+            None when the worker was already started, is not to be started yet, or could
+            not be started.
+        """
+        if self._pool is not None or self._failed or (
+                self._ready is not None and not self._ready()):
+            return None
+        return self._start(_warm_up)
+
+    def _start(self, fn: Callable, *args):
+        """Create the pool and submit ``fn(*args)`` (which spawns the worker)."""
         import multiprocessing
         from concurrent.futures import ProcessPoolExecutor
 
@@ -153,7 +183,7 @@ class FigureProcess:
                                        mp_context=multiprocessing.get_context("spawn"),
                                        initializer=_worker_init)
             with starting_quietly():
-                future = pool.submit(_draw_pickled, payload)
+                future = pool.submit(fn, *args)
         except (OSError, RuntimeError):  # no process to be had: this one draws everything
             self._failed = True
             return None

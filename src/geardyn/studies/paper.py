@@ -192,6 +192,8 @@ def stiffness_stage(case: Case, out: Path, result: StudyResult) -> None:
         # memory allow: geardyn.stiffness.fe.background)
         if bodies:
             result.background.append(bodies.process)
+        if result.background:  # the figure process starts as soon as they have ended (its
+            result.figures.start_early()  # imports then overlap this one's work)
         warnings.simplefilter("ignore")  # the maps record their warnings in attrs (read below)
         healthy = _build_map_with_progress(build_map, map_case, False, result,
                                            "stiffness (healthy)")

@@ -104,7 +104,11 @@ class StudyResult:
     measured_tsa: dict = field(default_factory=dict)
 
     def emit(self, stage: str, done: int, total: int) -> None:
-        """Report progress (see the module docstring); a no-op without a callback."""
+        """Report progress (see the module docstring); a no-op without a callback. Each report
+        also lets the figure process start if it may (:meth:`FigureStore.poll`)."""
+        poll = getattr(self.figures, "poll", None)
+        if poll is not None:
+            poll()
         if self.progress is not None:
             self.progress(stage, done, total)
 
@@ -292,6 +296,12 @@ class _Pending:
 #: by about 250 MB (measured 2026-11-26).
 IN_FLIGHT = 2
 
+#: The same bound once :meth:`FigureStore.finish` draws the held figures here: the process then
+#: gets the next figure only when it has drawn the last, so that no figure waits in its queue
+#: while this process, out of figures to draw, waits for it (the end of a first
+#: ``geardyn run --quick`` had this process idle about 0.9 s for the queued one, 2026-11-27).
+IN_FLIGHT_AT_FINISH = 1
+
 
 class FigureStore(dict):
     """Figure name -> :class:`RenderedFigure`: a matplotlib figure assigned is rendered to PNG
@@ -314,6 +324,9 @@ class FigureStore(dict):
         self.process = process
         self._held: deque = deque()    # handed over, not sent yet, in order
         self._in_flight = 0
+        self._limit = IN_FLIGHT         # IN_FLIGHT_AT_FINISH once finish() draws here too
+        self._early = False             # start_early(): poll() starts the process when ready
+        self._next_poll = 0.0
         self._lock = threading.RLock()  # _held, _in_flight: this thread and the pool's callbacks
 
     def __setitem__(self, key, fig) -> None:
@@ -343,11 +356,12 @@ class FigureStore(dict):
 
     def _pump(self) -> None:
         """Send held figures, first come first, while fewer than :data:`IN_FLIGHT` are in the
-        process's hands (from this thread, and from the pool's thread as each is drawn)."""
+        process's hands (:data:`IN_FLIGHT_AT_FINISH` during :meth:`finish`), from this thread,
+        and from the pool's thread as each is drawn."""
         from .figure_process import NotPicklable
 
         with self._lock:
-            while self.process is not None and self._held and self._in_flight < IN_FLIGHT:
+            while self.process is not None and self._held and self._in_flight < self._limit:
                 job = self._held[0]
                 try:
                     future = self.process.submit(job.draw, job.args, job.kwargs)
@@ -402,6 +416,8 @@ class FigureStore(dict):
         pending = self._pending()
         if not pending:
             return
+        with self._lock:
+            self._limit = IN_FLIGHT_AT_FINISH
         self._pump()
         while True:
             with self._lock:
@@ -420,6 +436,37 @@ class FigureStore(dict):
         if self.process is not None:
             self.process.close()
             self.process = None
+
+    def start_early(self) -> None:
+        """Let :meth:`poll` start the figure process as soon as ``ready()`` allows (the study's
+        other background processes have ended), rather than at the next figure handed over.
+
+        A first ``geardyn run --quick`` asked the process to start only at its next figure,
+        about a second after the kernel's compiler had ended, and the worker then spent a
+        second importing while the second core idled (2026-11-27).
+        """
+        self._early = self.process is not None
+
+    def poll(self) -> None:
+        """Start the figure process if :meth:`start_early` asked for it and ``ready()`` now
+        allows: with the held figures, or, with none held, on its imports
+        (:meth:`.figure_process.FigureProcess.warm_up`). Cheap (asked at most every 50 ms);
+        called by the study at each progress report, in this thread."""
+        import time
+
+        if not self._early:
+            return
+        now = time.monotonic()
+        if now < self._next_poll:
+            return
+        self._next_poll = now + 0.05
+        if self.process is None or self.process.started:
+            self._early = False
+            return
+        self._pump()
+        if self.process is not None and not self.process.started:
+            self.process.warm_up()
+        self._early = self.process is not None and not self.process.started
 
     def cached(self, key, draw: Callable, *args, **kwargs) -> None:
         """``self[key] = draw(*args, **kwargs)``, through the disk cache (kind ``figure``): the
