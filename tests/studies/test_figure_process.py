@@ -380,18 +380,18 @@ def test_a_figure_another_store_has_cached_meanwhile_is_read_from_the_cache(tmp_
 
 
 def draw_slow_here(y, here: int, *, title="t"):
-    """:func:`draw`, a second slower in the process ``here`` (the test's) than in the worker."""
+    """:func:`draw`, 0.6 s slower in the process ``here`` (the test's) than in the worker."""
     import time
 
     if os.getpid() == here:
-        time.sleep(1.0)
+        time.sleep(0.6)
     return draw(y, title=title)
 
 
 def test_at_finish_the_process_gets_one_figure_at_a_time(monkeypatch):
     """While ``finish`` draws the held figures here, the process is sent the next figure only
     once it has drawn the last (:data:`IN_FLIGHT_AT_FINISH`): no figure waits in its queue
-    while this process, out of figures, waits for it. Each figure takes a second longer here,
+    while this process, out of figures, waits for it. Each figure takes 0.6 s longer here,
     so the worker finishes its two in flight while this process draws; with the window left at
     :data:`IN_FLIGHT`, the first of them drawn lets another go at once."""
     monkeypatch.setenv("GEARDYN_NO_CACHE", "1")
