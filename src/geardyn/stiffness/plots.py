@@ -84,9 +84,19 @@ def pair_load_share(m: StiffnessMap, theta, dd: float, pinion_tooth: int) -> np.
 def crack_angle(healthy: StiffnessMap, cracked: StiffnessMap, dd: float = 0.0,
                 n: int = 4096) -> float:
     """Pinion angle where the cracked map falls furthest below the healthy one [rad]."""
-    th = np.linspace(0.0, cracked.period, n, endpoint=False)
-    ratio = cracked(th, dd) / healthy(th, dd)
-    return float(th[int(np.argmin(ratio))])
+    return fault_dip(healthy, cracked, dd, n)[0]
+
+
+def fault_dip(healthy: StiffnessMap, faulty: StiffnessMap, dd: float = 0.0,
+              n: int = 4096) -> tuple[float, float]:
+    """Where the faulty map falls furthest below the healthy one, relative to it: the pinion
+    angle [rad] (``n`` points over the faulty map's period, centre distance change ``dd`` [m])
+    and the ratio ``faulty / healthy`` there [-] (1 where the fault leaves the map
+    unchanged)."""
+    th = np.linspace(0.0, faulty.period, n, endpoint=False)
+    ratio = faulty(th, dd) / healthy(th, dd)
+    k = int(np.argmin(ratio))
+    return float(th[k]), float(ratio[k])
 
 
 def _parameters(m: StiffnessMap) -> dict:

@@ -47,6 +47,7 @@ from .paper_result import FigureStore, Progress, StudyResult
 from .paper_validation import validation_tables
 from .paper_values import (
     CONDITION_METRICS,
+    FAULT_DIP,
     PAPER_PM_LEVEL_DEG,
     PAPER_TABLE2,
     PAPER_TABLE3,
@@ -415,16 +416,20 @@ class CachedRecords(Mapping):
         return len(self._jobs)
 
 
-def _crack_angle(case: Case, result: StudyResult) -> float | None:
-    """Pinion angle [rad] where the crack lowers the stiffness most (from the maps, at 0 mm;
-    the stiffness stage has it already)."""
-    if case.crack is None or not case.crack.active or "cracked" not in result.maps:
+def _fault_angle(case: Case, result: StudyResult) -> float | None:
+    """Pinion angle [rad] of the fault events Figs. 8-10 are centred on and mark: where the
+    faulty map falls furthest below the healthy one, at 0 mm (for a crack the stiffness stage
+    has it). For a fault other than a crack only where that loss reaches :data:`FAULT_DIP`;
+    None for a healthy pair or a fault the maps do not show."""
+    if "cracked" not in result.maps or not fault_word(case):
         return None
-    if result.crack_angle_rad is not None:
+    crack = case.crack is not None and case.crack.active
+    if crack and result.crack_angle_rad is not None:
         return result.crack_angle_rad
-    from ..stiffness.plots import crack_angle
+    from ..stiffness.plots import fault_dip
 
-    return crack_angle(result.maps["healthy"], result.maps["cracked"], 0.0)
+    angle, ratio = fault_dip(result.maps["healthy"], result.maps["cracked"], 0.0)
+    return angle if crack or ratio < 1.0 - FAULT_DIP else None
 
 
 #: Variables of a simulation record stored as float32 in ``runs/*.nc``: derived quantities that
@@ -553,11 +558,20 @@ def simulation_stage(case: Case, out: Path, result: StudyResult) -> None:
     s.setdefault("sources", {})["centre_distance_change_mm"] = (
         "mean over the model II record with the crack (simulation stage)")
 
-    # Figs. 8-10 around the first crack event of the record
-    ca = _crack_angle(case, result)
+    # Figs. 8-10 around the first fault event of the record (its middle when the maps do not
+    # locate the fault); the events recur with the faulty map's period (one revolution of the
+    # faulty gear)
+    ca = _fault_angle(case, result)
     result.crack_angle_rad = ca
+    period = result.maps["cracked"].period if ca is not None else 2 * math.pi
+    if ca is not None:
+        s["fault_event_angle_deg"] = math.degrees(ca)
+        s["fault_event_period_deg"] = math.degrees(period)
+    else:
+        s.pop("fault_event_angle_deg", None)
+        s.pop("fault_event_period_deg", None)
     t = ds2["time"].values
-    tcs = pf.crack_times(ds2, ca) if ca is not None else np.array([])
+    tcs = pf.crack_times(ds2, ca, period) if ca is not None else np.array([])
     tc = float(tcs[0]) if tcs.size else float(t[0] + 0.5 * (t[-1] - t[0]))
     half = 0.55 * rev
     w8 = (max(t[0], tc - half), min(t[-1], tc + half))
@@ -565,20 +579,21 @@ def simulation_stage(case: Case, out: Path, result: StudyResult) -> None:
     # each figure gets only the variables it draws (a figure queued for the figure process
     # holds its arguments until drawn: a full run's record is 24 variables, 19 MB)
     result.figures.cached("fig8_design_parameters", pf.fig8_design_parameters,
-                          _variables(ds2, FIG8_VARIABLES), ca, w8, fault=fault)
+                          _variables(ds2, FIG8_VARIABLES), ca, w8, fault=fault,
+                          period=period)
     ds_s = runs[("II-start", "cracked")]
     ts = ds_s["time"].values
-    tcs_s = pf.crack_times(ds_s, ca) if ca is not None else np.array([])
+    tcs_s = pf.crack_times(ds_s, ca, period) if ca is not None else np.array([])
     tc_s = float(tcs_s[0]) if tcs_s.size else float(ts[0] + 0.5 * (ts[-1] - ts[0]))
     w9 = (max(ts[0], tc_s - 0.012), min(ts[-1], tc_s + 0.012))
     result.figures.cached("fig9_iteration", pf.fig9_iteration,
                           _variables(ds_s, FIG9_VARIABLES), _variables(ds2, ("residual_before",)),
-                          ca, w9, case.simulation.tolerance)
+                          ca, w9, case.simulation.tolerance, period=period)
     result.figures.cached("fig10_stiffness", pf.fig10_stiffness,
                           _variables(runs[("I", "cracked")], ("mesh_stiffness",)),
                           _variables(ds2, ("mesh_stiffness", "theta_p")), ca, w8,
                           ds_i_static=_variables(runs[("I-static", "cracked")],
-                                                 ("mesh_stiffness",)))
+                                                 ("mesh_stiffness",)), period=period)
     result.summary["model_comparison"] = model_comparison(runs)
     if result.summary["model_comparison"]:
         result.figures.cached("fig_model_comparison", pf.fig_model_comparison,

@@ -37,13 +37,16 @@ def _new_figure(**kwargs) -> Figure:
     return Figure(**kwargs)
 
 
-def crack_times(ds, crack_angle: float) -> np.ndarray:
-    """Times [s] at which the pinion angle passes ``crack_angle`` [rad] (mod 2 pi)."""
+def crack_times(ds, crack_angle: float, period: float = 2 * math.pi) -> np.ndarray:
+    """Times [s] at which the pinion angle passes ``crack_angle`` [rad] modulo ``period``
+    [rad]: the period of the faulty stiffness map (:attr:`StiffnessMap.period`), one pinion
+    revolution (2 pi) for a fault on the pinion, one gear revolution (``2 pi z2 / z1`` of
+    pinion angle) for a fault on the gear."""
     th = ds["theta_p"].values
     t = ds["time"].values
-    k0 = math.ceil((th[0] - crack_angle) / (2 * math.pi))
-    k1 = math.floor((th[-1] - crack_angle) / (2 * math.pi))
-    targets = crack_angle + 2 * math.pi * np.arange(k0, k1 + 1)
+    k0 = math.ceil((th[0] - crack_angle) / period)
+    k1 = math.floor((th[-1] - crack_angle) / period)
+    targets = crack_angle + period * np.arange(k0, k1 + 1)
     return np.interp(targets, th, t)
 
 
@@ -58,10 +61,11 @@ def _plain_axis(ax) -> None:
 
 
 def fig8_design_parameters(ds, crack_angle: float | None, window: tuple[float, float],
-                           fault: str = "crack") -> Figure:
+                           fault: str = "crack", period: float = 2 * math.pi) -> Figure:
     """Fig. 8 analogue: centre distance change, operating pressure angle and contact ratio of
     model II against time from the start of the record, with the fault's events marked
-    (``fault``: the title's word for it, "crack" or "fault").
+    (``fault``: the title's word for it, "crack" or "fault"; ``period``: as in
+    :func:`crack_times`).
 
     The physical contact ratio and the paper's eq. 8 value differ by more than their
     variation, so each has its own panel (on one axis both would look flat)."""
@@ -81,7 +85,7 @@ def fig8_design_parameters(ds, crack_angle: float | None, window: tuple[float, f
     axs[3].set_ylabel("contact ratio,\npaper eq. 8 [-]")
     axs[3].set_xlabel("time from the start of the record [s]")
     if crack_angle is not None:
-        for tc in crack_times(ds, crack_angle):
+        for tc in crack_times(ds, crack_angle, period):
             if window[0] <= tc <= window[1]:
                 for ax in axs:
                     ax.axvline(tc - t0, color="0.4", ls="--", lw=0.8)
@@ -94,7 +98,8 @@ def fig8_design_parameters(ds, crack_angle: float | None, window: tuple[float, f
 
 
 def fig9_iteration(ds_scheme, ds_default, crack_angle: float | None,
-                   window: tuple[float, float], tolerance: float) -> Figure:
+                   window: tuple[float, float], tolerance: float,
+                   period: float = 2 * math.pi) -> Figure:
     """Fig. 9 analogue: |b1 - b2| before and after the iteration, iterations per step and the
     mesh stiffness used, for the paper's start-of-step scheme; the default (predictor) run's
     first-solve |b1 - b2| is shown for comparison."""
@@ -118,7 +123,7 @@ def fig9_iteration(ds_scheme, ds_default, crack_angle: float | None,
     axs[2].set_ylabel(r"$K_m(\theta, d)$ [N/m]")
     axs[2].set_xlabel("time [s]")
     if crack_angle is not None:
-        for tc in crack_times(ds_scheme, crack_angle):
+        for tc in crack_times(ds_scheme, crack_angle, period):
             if window[0] <= tc <= window[1]:
                 for ax in axs:
                     ax.axvline(tc, color="0.4", ls="--", lw=0.8)
@@ -128,7 +133,7 @@ def fig9_iteration(ds_scheme, ds_default, crack_angle: float | None,
 
 
 def fig10_stiffness(ds_i, ds_ii, crack_angle: float | None, window: tuple[float, float],
-                    ds_i_static=None) -> Figure:
+                    ds_i_static=None, period: float = 2 * math.pi) -> Figure:
     """Fig. 10 analogue: the mesh stiffness the models used, K_m(theta) and K_m(theta, d).
 
     With ``ds_i_static`` (a model I-static record) its K_m(theta, d_s) at the static operating
@@ -145,7 +150,7 @@ def fig10_stiffness(ds_i, ds_ii, crack_angle: float | None, window: tuple[float,
         ax.plot(ds["time"].values[sel], ds["mesh_stiffness"].values[sel], lw=lw, ls=ls,
                 label=lab, color=COLORS[m])
     if crack_angle is not None:
-        for tc in crack_times(ds_ii, crack_angle):
+        for tc in crack_times(ds_ii, crack_angle, period):
             if window[0] <= tc <= window[1]:
                 ax.axvline(tc, color="0.4", ls="--", lw=0.8)
     ax.set_xlabel("time [s]")

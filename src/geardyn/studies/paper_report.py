@@ -22,6 +22,7 @@ from .paper_result import StudyResult
 from .paper_validation import SHAPE_FACTOR, STD_FACTOR
 from .paper_values import (
     CONDITION_METRICS,
+    FAULT_DIP,
     PAPER_TABLE2,
     PAPER_TABLE3,
     SIGNAL_KEYS,
@@ -578,6 +579,22 @@ def _own_case_title(case: Case, diffs: list[dict]) -> tuple[str, str]:
             "values")
 
 
+def fault_event_words(s: dict, faulty_pair: bool, faulty: str, fault: str) -> str:
+    """Where the Figs. 8-10 analogues are centred, for their captions: around the first fault
+    event when the study located it (summary keys ``fault_event_angle_deg`` and
+    ``fault_event_period_deg``), else the middle of the record, with the reason for a faulty
+    pair (``faulty_pair``) whose maps do not locate the fault."""
+    event = s.get("fault_event_angle_deg")
+    if event is not None:
+        return (f"around a {fault} event (dashed: the pinion passes {event:.1f} deg, where the "
+                f"{faulty} map falls furthest below the healthy one, every "
+                f"{s.get('fault_event_period_deg', 360.0):.1f} deg)")
+    if faulty_pair:
+        return (f"in the middle of the record (the stiffness maps do not locate this {fault}: "
+                f"the {faulty} map nowhere falls {FAULT_DIP:.1%} below the healthy one)")
+    return "in the middle of the record"
+
+
 def report_stage(case: Case, out: Path, result: StudyResult) -> None:
     """Write ``results.nc`` and the self-contained ``report.html``; PNGs into ``figures/``."""
     t_report = time.perf_counter()
@@ -747,8 +764,9 @@ def report_stage(case: Case, out: Path, result: StudyResult) -> None:
                "steps iterating [-]", "max |b1 - b2| before [um]"], srows,
               caption="Simulated records (means over the recorded time)")
     fig("fig8_design_parameters", "Fig. 8 analogue: centre distance change, operating pressure "
-                                  f"angle and contact ratio of model II around a {fault} event; "
-                                  "time from the start of the record.")
+                                  "angle and contact ratio of model II "
+                                  f"{fault_event_words(s, bool(_fault_word(case)), faulty, fault)}"
+                                  "; time from the start of the record.")
     fig("fig9_iteration", "Fig. 9 analogue: |b1 - b2| before and after the iteration, the "
                           "number of iterations and the mesh stiffness used.")
     fig("fig10_stiffness", "Fig. 10 analogue: mesh stiffness used by model I, K_m(theta), and "

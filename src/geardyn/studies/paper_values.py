@@ -11,7 +11,7 @@ from typing import Any
 
 __all__ = ["SIGNAL_KEYS", "SIGNAL_TITLES", "CONDITION_METRICS", "PAPER_TABLE2", "PAPER_TABLE3",
            "PAPER_PM_LEVEL_DEG", "PAPER_VALUES", "NUMERICAL_KEYS", "case_differences",
-           "fault_word", "faulty_words"]
+           "fault_word", "faulty_words", "FAULT_DIP"]
 
 #: The paper's names of the three signals (summary.json keys) by geardyn variable.
 SIGNAL_KEYS = {"v_yg": "gear_vertical_velocity", "omega_p": "pinion_angular_velocity",
@@ -144,6 +144,13 @@ def case_differences(case, reference=None) -> tuple[list[dict], list[dict]]:
         row = {"key": key, "paper": pa, "case": pb}
         (numerical if key in NUMERICAL_KEYS else inputs).append(row)
     return inputs, numerical
+
+
+#: Smallest relative stiffness loss [-] by which the faulty map locates a fault other than a
+#: crack (Figs. 8-10 of ``geardyn run`` are centred on its events): below it the fault acts
+#: mainly through the excitation (e.g. wear without its stiffness term, whose map equals the
+#: healthy one), and the map's lowest point tells nothing of where the fault is.
+FAULT_DIP = 1e-3
 
 
 def fault_word(case) -> str:
