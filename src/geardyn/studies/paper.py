@@ -567,9 +567,6 @@ def simulation_stage(case: Case, out: Path, result: StudyResult) -> None:
     if ca is not None:
         s["fault_event_angle_deg"] = math.degrees(ca)
         s["fault_event_period_deg"] = math.degrees(period)
-    else:
-        s.pop("fault_event_angle_deg", None)
-        s.pop("fault_event_period_deg", None)
     t = ds2["time"].values
     tcs = pf.crack_times(ds2, ca, period) if ca is not None else np.array([])
     tc = float(tcs[0]) if tcs.size else float(t[0] + 0.5 * (t[-1] - t[0]))
