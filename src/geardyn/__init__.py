@@ -3,14 +3,32 @@
 Implements Xue & Howard (2018), "Dynamic modelling of flexibly supported gears using iterative
 convergence of tooth mesh stiffness", end to end: geometry, mesh stiffness, the 6-DOF model I / II
 dynamics and gear diagnostics.
+
+The names below are imported on first use (PEP 562): ``import geardyn`` alone loads neither
+the case models (pydantic) nor the geometry, so that a process that needs one part of geardyn
+(the report's figure process, the kernel's compiler, a CLI refusal) does not import the rest.
+``from geardyn import Case`` and ``geardyn.Case`` work as before.
 """
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from ._version import __version__
-from .config import Case, load_case, paper_case
-from .errors import DataFileError, GeardynError, GeometryError, InputError, NumericalError
-from .geometry import Gear, GearPair, OperatingGeometry, centre_distance_from_displacements
+
+if TYPE_CHECKING:  # for type checkers and IDEs; at run time see __getattr__
+    from .config import Case, load_case, paper_case
+    from .errors import DataFileError, GeardynError, GeometryError, InputError, NumericalError
+    from .geometry import Gear, GearPair, OperatingGeometry, centre_distance_from_displacements
+
+#: Public name -> the submodule that defines it.
+_LAZY = {
+    "Case": "config", "load_case": "config", "paper_case": "config",
+    "Gear": "geometry", "GearPair": "geometry", "OperatingGeometry": "geometry",
+    "centre_distance_from_displacements": "geometry",
+    "GeardynError": "errors", "InputError": "errors", "GeometryError": "errors",
+    "NumericalError": "errors", "DataFileError": "errors",
+}
 
 __all__ = [
     "__version__",
@@ -27,3 +45,18 @@ __all__ = [
     "NumericalError",
     "DataFileError",
 ]
+
+
+def __getattr__(name: str):
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module 'geardyn' has no attribute {name!r}")
+    import importlib
+
+    value = getattr(importlib.import_module(f".{module}", __name__), name)
+    globals()[name] = value  # imported once
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))

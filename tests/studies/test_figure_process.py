@@ -465,3 +465,59 @@ def test_start_early_starts_the_process_at_the_first_poll_it_may(monkeypatch):
     none.start_early()
     none.poll()
     assert none.process is None
+
+
+def test_what_the_study_hands_over_draws_without_xarray_or_the_case_models(tmp_path):
+    """The figure process imports what drawing needs, not what the study's objects would pull
+    in: the figures as the study hands them over (Figs. 5-6 by module and name, Fig. 8 from a
+    record's arrays, Fig. 11 from diagnoses), pickled here, are unpickled and drawn by
+    :func:`~geardyn.studies.figure_process.draw_png` in a fresh interpreter that then holds
+    neither xarray, pandas nor pydantic (together about 60 MB and 0.4 s there; it imported
+    all three until 2026-11-27, through a record passed as a Dataset and a class of the study
+    module). The same PNG bytes as drawn here."""
+    import math
+    import pickle
+    import subprocess
+    import sys
+
+    import xarray as xr
+
+    from geardyn.diagnostics import diagnose
+    from geardyn.studies import paper_figures as pf
+    from geardyn.studies.figure_process import draw_png
+    from geardyn.studies.paper import FIG8_VARIABLES, _variables
+    from geardyn.studies.paper_result import ImportedOnCall
+
+    w, fs, z = 114.14, 20000.0, 23
+    t = np.arange(int(6 * 2 * np.pi / w * fs)) / fs
+    theta = w * t
+    pulse = np.exp(-0.5 * ((np.mod(theta, 2 * np.pi) - 3.0) / 0.02) ** 2)
+    record = xr.Dataset({name: ("time", 1.0 + 0.01 * np.cos(z * theta) + 0.001 * k * pulse)
+                         for k, name in enumerate(FIG8_VARIABLES)} | {"theta_p": ("time", theta)},
+                        coords={"time": t})
+    signals = {"v_yg": 0.01 * np.cos(z * theta) + 0.003 * pulse,
+               "omega_p": w + 0.1 * np.cos(z * theta),
+               "transmission_error": 0.05 + 1e-5 * pulse}
+    diagnosis = diagnose(signals, teeth=z, time=t, angle=theta, samples_per_rev=256)
+    curves = {"x": np.linspace(0.0, 1.0, 50), "xlabel": "x [-]", "ylabel": "y [-]",
+              "title": "curves", "lines": [{"y": np.linspace(0.0, 2.0, 50), "label": "a"}]}
+    jobs = [(ImportedOnCall("geardyn.line_figure", "draw_line_figure"), (curves,), {}),
+            (pf.fig8_design_parameters, (_variables(record, FIG8_VARIABLES), 3.0, (0.0, 0.2)),
+             {"fault": "crack", "period": 2 * math.pi}),
+            (pf.fig_tsa, ({"I": diagnosis, "II": diagnosis},), {})]
+    expected = [draw_png(draw, args, kwargs) for draw, args, kwargs in jobs]
+    (tmp_path / "jobs.pkl").write_bytes(pickle.dumps(jobs, protocol=pickle.HIGHEST_PROTOCOL))
+    code = (
+        "import pickle, sys\n"
+        "from geardyn.studies.figure_process import _warm_up, draw_png\n"
+        "_warm_up()\n"
+        "jobs = pickle.loads(open(sys.argv[1], 'rb').read())\n"
+        "pngs = [draw_png(d, a, k) for d, a, k in jobs]\n"
+        "open(sys.argv[2], 'wb').write(pickle.dumps(pngs))\n"
+        "print(' '.join(m for m in ('xarray', 'pandas', 'pydantic') if m in sys.modules))\n")
+    out = subprocess.run([sys.executable, "-c", code, str(tmp_path / "jobs.pkl"),
+                          str(tmp_path / "pngs.pkl")], capture_output=True, text=True,
+                         timeout=300, env={**os.environ, "MPLBACKEND": "Agg"})
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == "", out.stdout
+    assert pickle.loads((tmp_path / "pngs.pkl").read_bytes()) == expected

@@ -96,12 +96,12 @@ def test_a_deferred_argument_is_computed_only_when_the_figure_is_drawn(tmp_path,
 def test_a_function_imported_on_call_keeps_the_figure_key(tmp_path, monkeypatch):
     """The study passes some drawing functions by module and name (no import until drawn);
     the figure cache knows them by the same key as the function itself."""
-    from geardyn.studies.paper import _ImportedOnCall
+    from geardyn.studies.paper_result import ImportedOnCall
 
     monkeypatch.setenv("GEARDYN_CACHE_DIR", str(tmp_path / "cache"))
     CALLS.clear()
     y = np.arange(4.0)
-    lazy = _ImportedOnCall(draw.__module__, draw.__qualname__)
+    lazy = ImportedOnCall(draw.__module__, draw.__qualname__)
     FigureStore().cached("f", draw, y, title="x")
     FigureStore().cached("f", lazy, y, title="x")
     assert CALLS == ["x"]

@@ -37,13 +37,19 @@ def _new_figure(**kwargs) -> Figure:
     return Figure(**kwargs)
 
 
+def _v(ds, name: str) -> np.ndarray:
+    """The values of variable ``name`` of a record: an :class:`xarray.Dataset`, or a mapping of
+    name -> array (what the study hands to the figure process, which then needs no xarray)."""
+    return np.asarray(ds[name])
+
+
 def crack_times(ds, crack_angle: float, period: float = 2 * math.pi) -> np.ndarray:
     """Times [s] at which the pinion angle passes ``crack_angle`` [rad] modulo ``period``
     [rad]: the period of the faulty stiffness map (:attr:`StiffnessMap.period`), one pinion
     revolution (2 pi) for a fault on the pinion, one gear revolution (``2 pi z2 / z1`` of
     pinion angle) for a fault on the gear."""
-    th = ds["theta_p"].values
-    t = ds["time"].values
+    th = _v(ds, "theta_p")
+    t = _v(ds, "time")
     k0 = math.ceil((th[0] - crack_angle) / period)
     k1 = math.floor((th[-1] - crack_angle) / period)
     targets = crack_angle + period * np.arange(k0, k1 + 1)
@@ -51,7 +57,7 @@ def crack_times(ds, crack_angle: float, period: float = 2 * math.pi) -> np.ndarr
 
 
 def _window(ds, t0: float, t1: float):
-    t = ds["time"].values
+    t = _v(ds, "time")
     return (t >= t0) & (t <= t1)
 
 
@@ -68,20 +74,24 @@ def fig8_design_parameters(ds, crack_angle: float | None, window: tuple[float, f
     :func:`crack_times`).
 
     The physical contact ratio and the paper's eq. 8 value differ by more than their
-    variation, so each has its own panel (on one axis both would look flat)."""
+    variation, so each has its own panel (on one axis both would look flat).
+
+    ``ds``, and the records of :func:`fig9_iteration` and :func:`fig10_stiffness`: a model
+    record (:class:`xarray.Dataset`) or a mapping of its variable names (``time`` [s] among
+    them) to arrays."""
     fig = _new_figure(figsize=(8.5, 8.6), layout="constrained")
     axs = fig.subplots(4, 1, sharex=True)
     sel = _window(ds, *window)
-    t_all = ds["time"].values
+    t_all = _v(ds, "time")
     t0 = float(t_all[0])
     t = t_all[sel] - t0
-    axs[0].plot(t, ds["centre_distance_change"].values[sel] * 1e3, lw=0.9)
+    axs[0].plot(t, _v(ds, "centre_distance_change")[sel] * 1e3, lw=0.9)
     axs[0].set_ylabel("centre distance change\n$d(t) - d$ [mm]")
-    axs[1].plot(t, np.degrees(ds["pressure_angle"].values[sel]), lw=0.9)
+    axs[1].plot(t, np.degrees(_v(ds, "pressure_angle")[sel]), lw=0.9)
     axs[1].set_ylabel("operating pressure\nangle [deg]")
-    axs[2].plot(t, ds["contact_ratio"].values[sel], lw=0.9, color="tab:green")
+    axs[2].plot(t, _v(ds, "contact_ratio")[sel], lw=0.9, color="tab:green")
     axs[2].set_ylabel("contact ratio,\nphysical [-]")
-    axs[3].plot(t, ds["contact_ratio_eq8"].values[sel], lw=0.9, color="tab:purple")
+    axs[3].plot(t, _v(ds, "contact_ratio_eq8")[sel], lw=0.9, color="tab:purple")
     axs[3].set_ylabel("contact ratio,\npaper eq. 8 [-]")
     axs[3].set_xlabel("time from the start of the record [s]")
     if crack_angle is not None:
@@ -106,20 +116,20 @@ def fig9_iteration(ds_scheme, ds_default, crack_angle: float | None,
     fig = _new_figure(figsize=(8.5, 7.5), layout="constrained")
     axs = fig.subplots(3, 1, sharex=True)
     sel = _window(ds_scheme, *window)
-    t = ds_scheme["time"].values[sel]
-    axs[0].plot(t, ds_scheme["residual_before"].values[sel] * 1e6, color="tab:red", lw=0.8,
+    t = _v(ds_scheme, "time")[sel]
+    axs[0].plot(t, _v(ds_scheme, "residual_before")[sel] * 1e6, color="tab:red", lw=0.8,
                 label="before iteration (paper's start-of-step scheme)")
-    axs[0].plot(t, ds_scheme["residual_after"].values[sel] * 1e6, color="k", lw=0.8,
+    axs[0].plot(t, _v(ds_scheme, "residual_after")[sel] * 1e6, color="k", lw=0.8,
                 label="after iteration")
     seld = _window(ds_default, *window)
-    axs[0].plot(ds_default["time"].values[seld], ds_default["residual_before"].values[seld] * 1e6,
+    axs[0].plot(_v(ds_default, "time")[seld], _v(ds_default, "residual_before")[seld] * 1e6,
                 color="tab:green", lw=0.8, label="geardyn default (predictor), first solve")
     axs[0].axhline(tolerance * 1e6, color="0.5", ls=":", lw=1, label="tolerance")
     axs[0].set_ylabel(r"$|b_1 - b_2|$ [$\mu$m]")
     axs[0].legend(fontsize=7, loc="upper right")
-    axs[1].step(t, ds_scheme["iterations"].values[sel], where="mid", lw=0.8)
+    axs[1].step(t, _v(ds_scheme, "iterations")[sel], where="mid", lw=0.8)
     axs[1].set_ylabel("iterations [-]")
-    axs[2].plot(t, ds_scheme["mesh_stiffness"].values[sel], lw=0.8)
+    axs[2].plot(t, _v(ds_scheme, "mesh_stiffness")[sel], lw=0.8)
     axs[2].set_ylabel(r"$K_m(\theta, d)$ [N/m]")
     axs[2].set_xlabel("time [s]")
     if crack_angle is not None:
@@ -147,7 +157,7 @@ def fig10_stiffness(ds_i, ds_ii, crack_angle: float | None, window: tuple[float,
                        "--", 1.1))
     for ds, lab, m, ls, lw in curves:
         sel = _window(ds, *window)
-        ax.plot(ds["time"].values[sel], ds["mesh_stiffness"].values[sel], lw=lw, ls=ls,
+        ax.plot(_v(ds, "time")[sel], _v(ds, "mesh_stiffness")[sel], lw=lw, ls=ls,
                 label=lab, color=COLORS[m])
     if crack_angle is not None:
         for tc in crack_times(ds_ii, crack_angle, period):

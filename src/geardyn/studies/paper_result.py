@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 __all__ = ["StudyResult", "Progress", "Deferred", "FigureStore", "RenderedFigure",
-           "render_png"]
+           "render_png", "ImportedOnCall"]
 
 Progress = Callable[[str, int, int], None]
 
@@ -274,6 +274,28 @@ def render_png(fig) -> bytes:
     fig.savefig(buf, format="png", dpi=FIGURE_DPI, bbox_inches=png_bbox(fig))
     plt.close(fig)
     return buf.getvalue()
+
+
+class ImportedOnCall:
+    """The function ``module.name``, imported when called.
+
+    It carries the function's ``__module__`` and ``__qualname__``, by which
+    :meth:`~.paper_result.FigureStore.cached` keys a figure, so a figure taken from the cache
+    does not import the module that draws it. It lives here, in a module the figure process
+    imports anyway: a figure handed to that process pickles a reference to this class, and
+    unpickling it imported the whole study module (with the case models, pydantic) when it
+    lived in :mod:`.paper` (found 2026-11-27).
+    """
+
+    def __init__(self, module: str, name: str):
+        self.__module__ = module
+        self.__qualname__ = name
+
+    def __call__(self, *args, **kwargs):
+        import importlib
+
+        return getattr(importlib.import_module(self.__module__), self.__qualname__)(*args,
+                                                                                   **kwargs)
 
 
 class _Pending:
