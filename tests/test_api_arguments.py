@@ -171,6 +171,30 @@ def test_map_evaluation_unchanged(kmap):
     assert kmap(0.3) == float(kmap(np.array([0.3]))[0])
 
 
+def test_map_evaluation_broadcasts_without_a_warning(kmap):
+    """theta and dd broadcast against each other (a scalar, arrays of one shape, a read-only
+    array) with no warning: NumPy 2 warned "future versions will not create a writeable array
+    from broadcast_array" when the map asked whether ``np.broadcast_arrays``' views were
+    writeable (seen by API users, 2026-11-27)."""
+    import warnings
+
+    th = np.linspace(0.0, 1.0, 7)
+    read_only = th.copy()
+    read_only.flags.writeable = False
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        a = kmap(th)
+        b = kmap(th, np.zeros(7))
+        c = kmap(read_only, 0.0)
+        grid = kmap(0.3, np.zeros((2, 3)))
+        one = kmap(np.array([0.3]), 0.0)
+    np.testing.assert_array_equal(a, b)
+    np.testing.assert_array_equal(a, c)
+    assert grid.shape == (2, 3) and np.all(grid == kmap(0.3))
+    assert one.shape == (1,) and one[0] == kmap(0.3)
+    assert not read_only.flags.writeable  # the caller's array is left as it was
+
+
 @pytest.mark.parametrize("n_theta", [-1, 0, 2.0])
 def test_regular_refuses_bad_counts(kmap, n_theta):
     _refused(lambda: kmap.regular(n_theta=n_theta), "n_theta")

@@ -327,6 +327,16 @@ def zone_boundaries(pair, dd: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.asarray(pa), np.asarray(la)
 
 
+def _flat_writeable(a: np.ndarray, shape: tuple) -> np.ndarray:
+    """``a`` broadcast to ``shape`` and flattened, writeable: numba types a read-only array
+    apart and would compile the look-up a second time (0.5 s) for it, so a read-only array (a
+    broadcast scalar, a file's array) is copied. ``np.broadcast_arrays`` is not used: asking its
+    views whether they are writeable warns (NumPy 2: "future versions will not create a
+    writeable array from broadcast_array"), and that warning reached API users."""
+    f = a.ravel() if a.shape == shape else np.broadcast_to(a, shape).ravel()
+    return f if f.flags.writeable else f.copy()
+
+
 @dataclass(frozen=True)
 class StiffnessMap:
     """Mesh stiffness over one period of pinion angle and a range of centre distance changes.
@@ -568,20 +578,15 @@ class StiffnessMap:
             raise InputError("dd", dd, "centre distance changes [m]: a number or an array of "
                                        "them")
         try:
-            th, d = np.broadcast_arrays(th, d)
+            shape = np.broadcast_shapes(th.shape, d.shape)
         except ValueError:
             raise InputError("dd", f"shape {d.shape}",
                              f"a shape that broadcasts with theta's {th.shape}") from None
-        th_f, d_f = th.ravel(), d.ravel()
-        if not (th_f.flags.writeable and d_f.flags.writeable):
-            # numba types a read-only array apart and would compile the lookup a second time
-            # (0.5 s) for it: a read-only theta or dd (a broadcast scalar, a file's array) is
-            # copied instead
-            th_f, d_f = th_f.copy(), d_f.copy()
+        th_f, d_f = _flat_writeable(th, shape), _flat_writeable(d, shape)
         out, bad = _lookup_many(th_f, d_f, *arr)
         if bad >= 0:
             raise InputError("theta", float(th_f[bad]), "finite pinion angles [rad]")
-        return out.reshape(th.shape) if th.shape else float(out[0])
+        return out.reshape(shape) if shape else float(out[0])
 
     def torsional(self, theta, dd=0.0) -> np.ndarray:
         """Combined torsional mesh stiffness ``K_t = k_mb r_b1^2`` [N m/rad]."""

@@ -15,8 +15,11 @@ and fonts; ``tests/studies/test_figure_process.py``). The process is an accelera
 figure it cannot draw (an error, a broken pool, arguments that do not pickle) is drawn again in
 this process, which raises the error, if any, with its own traceback.
 
-It costs memory: a second interpreter with matplotlib, xarray and geardyn imported (about
-150-200 MB). It is used where the FE bodies' second process would be
+It costs memory: a second interpreter with matplotlib, SciPy's FFT and geardyn's drawing code
+imported (84 MB; 140-170 MB at the end of a ``--quick`` run, with what it has drawn). What the
+study hands over unpickles without xarray, pandas or the case models (records as arrays,
+:class:`.paper_result.ImportedOnCall`): until 2026-11-27 they came with it, 40-60 MB more. It
+is used where the FE bodies' second process would be
 (:func:`geardyn.processes.fe_processes`: ``GEARDYN_FE_PROCESSES=0`` runs
 everything in one process), not from a daemon process (a pool's worker may not have children),
 and it starts only when ``ready()`` says so: the study waits until its other background
