@@ -467,6 +467,38 @@ def test_start_early_starts_the_process_at_the_first_poll_it_may(monkeypatch):
     assert none.process is None
 
 
+def test_start_early_stops_asking_once_the_process_could_not_start(monkeypatch):
+    """A worker that could not be started is not asked again at each later progress report
+    (``poll`` stops; the figures are drawn here), and a ``ready()`` that says no is asked
+    again."""
+    import time
+
+    monkeypatch.setenv("GEARDYN_NO_CACHE", "1")
+    asked = {"n": 0, "open": False}
+
+    def ready():
+        asked["n"] += 1
+        return asked["open"]
+
+    proc = FigureProcess(ready=ready)
+    monkeypatch.setattr(proc, "_start", lambda fn, *a: setattr(proc, "_failed", True))
+    store = FigureStore(proc)
+    store.start_early()
+    store.poll()
+    assert asked["n"] >= 1 and store._early     # not ready: asked again later
+    asked["open"] = True
+    time.sleep(0.06)
+    store.poll()                                # ready, but the start fails
+    assert proc.failed and not proc.started and not store._early
+    n = asked["n"]
+    time.sleep(0.06)
+    store.poll()
+    assert asked["n"] == n                      # not asked again
+    y = np.linspace(0.0, 1.0, 30)
+    store.cached("f", draw, y, title="f")       # drawn here
+    assert store["f"].png == _expected(y, "f")
+
+
 def test_what_the_study_hands_over_draws_without_xarray_or_the_case_models(tmp_path):
     """The figure process imports what drawing needs, not what the study's objects would pull
     in: the figures as the study hands them over (Figs. 5-6 by module and name, Fig. 8 from a

@@ -121,6 +121,11 @@ class FigureProcess:
         """Whether the worker process has been started."""
         return self._pool is not None
 
+    @property
+    def failed(self) -> bool:
+        """Whether the worker could not be started or has broken: it is not asked again."""
+        return self._failed
+
     def submit(self, draw: Callable, args: tuple, kwargs: dict):
         """Hand ``draw(*args, **kwargs)`` to the worker.
 

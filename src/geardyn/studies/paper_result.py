@@ -482,13 +482,15 @@ class FigureStore(dict):
         if now < self._next_poll:
             return
         self._next_poll = now + 0.05
-        if self.process is None or self.process.started:
+        if self.process is None or self.process.started or self.process.failed:
             self._early = False
             return
         self._pump()
         if self.process is not None and not self.process.started:
             self.process.warm_up()
-        self._early = self.process is not None and not self.process.started
+        # asked again until it has started, unless it could not be (then never)
+        self._early = (self.process is not None and not self.process.started
+                       and not self.process.failed)
 
     def cached(self, key, draw: Callable, *args, **kwargs) -> None:
         """``self[key] = draw(*args, **kwargs)``, through the disk cache (kind ``figure``): the
