@@ -127,6 +127,40 @@ def test_checks_can_fail():
     assert any("offset from where the cracked map" in q for q in bad)
 
 
+def _offset_rows(rows: list) -> dict:
+    return {r["quantity"].split(":")[0]: r for r in rows if "offset from where" in r["quantity"]}
+
+
+def test_another_pinion_fault_is_located_in_the_tsa_too():
+    """A spall or breakage on the pinion (no crack): the envelope's peak is checked against the
+    fault's event angle (where its map falls furthest below the healthy one) within the
+    envelope's resolution; not for a fault that recurs once per gear revolution, nor where the
+    maps did not locate the fault; a crack keeps its own row. Values: the spall example of
+    2026-11-27 (``--quick --stiffness pem``: 170.5 deg in the TSA, 169.3 deg in the maps)."""
+    s = _summary()
+    del s["crack_angle_in_stiffness_deg"]
+    s.update(crack_angle_deg=170.5, fault_event_angle_deg=169.3, fault_event_period_deg=360.0)
+    rows = _offset_rows(consistency_checks(s, paper_case=False))
+    assert set(rows) == {"fault seen in the TSA"} and rows["fault seen in the TSA"]["pass"]
+    assert rows["fault seen in the TSA"]["geardyn"] == pytest.approx(1.2)
+    s["crack_angle_deg"] = 169.3 + 360 / 23 + 0.1  # beyond the resolution
+    assert not _offset_rows(consistency_checks(s, paper_case=False))["fault seen in the TSA"][
+        "pass"]
+    s["crack_angle_deg"] = 359.0  # across 0 deg: -10.3 deg, within
+    s["fault_event_angle_deg"] = 9.3
+    row = _offset_rows(consistency_checks(s, paper_case=False))["fault seen in the TSA"]
+    assert row["pass"] and row["geardyn"] == pytest.approx(-10.3)
+    s["fault_event_period_deg"] = 446.4  # a gear tooth: once per gear revolution
+    assert _offset_rows(consistency_checks(s, paper_case=False)) == {}
+    s["fault_event_period_deg"] = 360.0
+    del s["fault_event_angle_deg"]  # not located by the maps
+    assert _offset_rows(consistency_checks(s, paper_case=False)) == {}
+    crack = _summary()
+    crack.update(fault_event_angle_deg=100.0, fault_event_period_deg=360.0)
+    assert set(_offset_rows(consistency_checks(crack, paper_case=False))) == {
+        "crack seen in the TSA"}
+
+
 # ------------------------------------------------------------------ paper case or not
 def test_case_differences_separate_inputs_from_numerical_settings():
     assert case_differences(paper_case()) == ([], [])

@@ -87,7 +87,8 @@ def consistency_checks(s: dict, *, paper_case: bool) -> list[dict]:
     s : dict
         The study summary (``summary.json``): ``design``, ``static``, ``simulations``,
         ``calibrated_speed_rad_s``, ``crack_angle_deg``, ``crack_angle_in_stiffness_deg``,
-        ``crack_angle_resolution_deg`` are used where present.
+        ``crack_angle_resolution_deg``, ``fault_event_angle_deg``, ``fault_event_period_deg``
+        are used where present.
     paper_case : bool
         Whether the inputs are the paper's: only then are Table 1 and the paper's static values
         checked.
@@ -156,15 +157,27 @@ def consistency_checks(s: dict, *, paper_case: bool) -> list[dict]:
             note="set by the bearing deflections of the static balance (the mesh deflection is "
                  "about 1% of it); Table 2 quotes one significant figure"))
     ca, cs = s.get("crack_angle_deg"), s.get("crack_angle_in_stiffness_deg")
+    res = s.get("crack_angle_resolution_deg", 360.0 / 23)
+    how = ("the narrowband envelope's peak (median over the signals and models) against the "
+           "pinion angle of the largest stiffness loss; tolerance: the envelope's angular "
+           "resolution, 360 deg / (2 B + 1) for a band of +/- B orders")
     if _finite(ca) and _finite(cs):
-        res = s.get("crack_angle_resolution_deg", 360.0 / 23)
         d = (ca - cs + 180.0) % 360.0 - 180.0
         rows.append(absolute_row(
             "crack seen in the TSA: offset from where the cracked map is weakest [deg]", 0.0, d,
-            res, unit="deg", source="geardyn's stiffness maps (stiffness stage)",
-            note="the narrowband envelope's peak (median over the signals and models) against "
-                 "the pinion angle of the largest stiffness loss; tolerance: the envelope's "
-                 "angular resolution, 360 deg / (2 B + 1) for a band of +/- B orders"))
+            res, unit="deg", source="geardyn's stiffness maps (stiffness stage)", note=how))
+    fe, period = s.get("fault_event_angle_deg"), s.get("fault_event_period_deg")
+    if (_finite(ca) and not _finite(cs) and _finite(fe) and _finite(period)
+            and abs(period - 360.0) < 1e-9):
+        # another fault on the pinion (a spall, a breakage...): the TSA's revolution is the
+        # pinion's, so it shows the fault once, where the faulty map falls furthest below the
+        # healthy one (at 0 mm: the fault events of Figs. 8-10); a gear-side fault recurs once
+        # per gear revolution and is not located by the pinion's TSA
+        d = (ca - fe + 180.0) % 360.0 - 180.0
+        rows.append(absolute_row(
+            "fault seen in the TSA: offset from where the faulty map is weakest [deg]", 0.0, d,
+            res, unit="deg", source="geardyn's stiffness maps (stiffness stage, at 0 mm)",
+            note=how))
     if paper_case and _finite(ca):
         rows.append(absolute_row(
             "crack seen in the TSA at [deg]", pv["crack_angle_deg"][0], ca, 360.0 / 23,
