@@ -180,6 +180,41 @@ def test_crack_must_stay_in_the_body(gear):
         crack_segment(gear, CrackGeometry(depth=40e-3, angle=math.radians(10)))
 
 
+def test_inside_the_outline_as_matplotlib_says(gear):
+    """The crack checks' point-in-polygon test (NumPy, even-odd rule) against matplotlib's
+    ``Path.contains_points`` (an independent implementation) on the whole gear's outline:
+    2000 random points over the gear's box, the polygon's own square, a ring and a triangle,
+    leaving out points within 1 um of an edge, where the rules may differ."""
+    from matplotlib.path import Path
+
+    from geardyn.stiffness.fe.mesh import _closed_polygon, _inside
+
+    def near_an_edge(poly, pts, tol):
+        a, b = poly, np.roll(poly, -1, axis=0)
+        d = b - a
+        t = np.clip(np.einsum("kij,ij->ki", pts[:, None, :] - a[None], d)
+                    / np.einsum("ij,ij->i", d, d), 0.0, 1.0)
+        gap = pts[:, None, :] - (a[None] + t[..., None] * d[None])
+        return np.hypot(gap[..., 0], gap[..., 1]).min(axis=1) < tol
+
+    rng = np.random.default_rng(7)
+    poly = _closed_polygon(gear)
+    r = 1.05 * gear.tip_radius
+    pts = rng.uniform(-r, r, (2000, 2))
+    keep = ~near_an_edge(poly, pts, 1e-6)
+    ours, theirs = _inside(poly, pts[keep]), Path(poly).contains_points(pts[keep])
+    np.testing.assert_array_equal(ours, theirs)
+    assert 300 < ours.sum() < keep.sum() - 300  # points on both sides
+    square = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    # a ray through a vertex (y = 1 at the corner (1, 1)) and along an edge's height
+    np.testing.assert_array_equal(
+        _inside(square, np.array([[0.5, 0.5], [1.5, 0.5], [-0.5, 1.0], [0.5, 0.999], [0.5, 2.0]])),
+        [True, False, False, True, False])
+    triangle = np.array([[0.0, 0.0], [2.0, 0.0], [1.0, 2.0]])
+    np.testing.assert_array_equal(_inside(triangle, np.array([[1.0, 1.0], [1.0, 2.5], [-1.0, 0.0]])),
+                                  [True, False, False])
+
+
 def test_bad_settings():
     with pytest.raises(InputError):
         MeshSettings(flank_size=1e-3, tooth_size=0.5e-3, body_size=2e-3)

@@ -59,7 +59,7 @@ def test_numba_lookup_matches_numpy_twin(cmap):
 def test_read_only_angles_use_the_compiled_lookup_of_writable_ones(cmap):
     """numba types a read-only array apart: a read-only theta (or dd) would compile the lookup a
     second time; the map copies it instead, so one signature serves both, with the same values."""
-    from geardyn.stiffness.map import _lookup_many
+    from geardyn.stiffness._lookup_kernels import _lookup_many
 
     th = np.linspace(-1.0, 7.0, 50)
     frozen = th.copy()

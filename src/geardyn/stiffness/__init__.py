@@ -11,7 +11,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from .map import MapArrays, StiffnessMap, lookup, lookup_reference
+from .map import MapArrays, StiffnessMap, lookup_reference
 
 __all__ = ["StiffnessMap", "MapArrays", "lookup", "lookup_reference", "build_map",
            "map_inputs", "centre_distance_grid", "fe_torque", "build_load_family",
@@ -277,3 +277,13 @@ def build_load_family(case, *, cracked: bool = True,
         if progress is not None:
             progress(i + 1, len(torques))
     return LoadFamily(torques, maps, case.gear_pair().pinion.base_radius)
+
+
+def __getattr__(name: str):
+    """:func:`~.map.lookup`, a compiled function, imported on first use: importing this
+    package (e.g. to build FE bodies) does not import numba (:mod:`._lookup_kernels`)."""
+    if name == "lookup":
+        from ._lookup_kernels import lookup
+
+        return lookup
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

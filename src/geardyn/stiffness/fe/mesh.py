@@ -275,9 +275,26 @@ def _closed_polygon(gear: Gear, n: int = 40) -> np.ndarray:
 
 
 def _inside(poly: np.ndarray, pts: np.ndarray) -> np.ndarray:
-    from matplotlib.path import Path
+    """Whether each point of ``pts`` (k, 2) lies inside the closed polygon ``poly`` (n, 2)
+    [m], by the even-odd (crossing-number) rule: a ray from the point crosses the outline an
+    odd number of times (as stated in PlanetMath, "determining when a point is inside a
+    polygon"). The ray goes towards +x; each edge is half-open in y, so a ray through a vertex
+    counts it once.
 
-    return Path(poly).contains_points(pts)
+    NumPy only, one point at a time over every edge. It replaced matplotlib's
+    ``Path.contains_points``, whose import (13 MB, 2026-11-27) came into the FE bodies'
+    process with the crack checks; ``tests/fe/test_mesh.py`` compares the two away from the
+    outline, where both rules agree.
+    """
+    x0, y0 = poly[:, 0], poly[:, 1]
+    x1, y1 = np.roll(x0, -1), np.roll(y0, -1)
+    out = np.empty(len(pts), dtype=bool)
+    for k, (x, y) in enumerate(np.asarray(pts, float)):
+        spans = (y0 > y) != (y1 > y)  # edges whose y-range holds y (half-open)
+        xa, ya, xb, yb = x0[spans], y0[spans], x1[spans], y1[spans]
+        xc = xa + (y - ya) * (xb - xa) / (yb - ya)  # where each crosses the horizontal line
+        out[k] = np.count_nonzero(x < xc) % 2 == 1
+    return out
 
 
 def crack_polyline(gear: Gear, crack: CrackGeometry) -> np.ndarray:

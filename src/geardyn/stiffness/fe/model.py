@@ -28,7 +28,6 @@ import numpy as np
 
 from ...errors import DataFileError, InputError, NumericalError
 from ...geometry import Gear
-from ._batch import solve_batch, solve_compatibility_fast
 from .contact import (
     BodyCompliance,
     CandidateGenerator,
@@ -321,6 +320,24 @@ def _row(cand: Candidates, q: int) -> Candidates:
 def _rows(cand: Candidates, q: np.ndarray) -> Candidates:
     """Positions ``q`` of a block of candidates, as a block."""
     return Candidates(**{k: getattr(cand, k)[q] for k in Candidates.__dataclass_fields__})
+
+
+
+def solve_batch(*args, **kwargs):
+    """:func:`._batch.solve_batch`, imported on the first call: a process that builds FE
+    bodies (the second process of :mod:`.background`) does not import numba before its
+    factorisations, which are the peak of a run's memory (numba: about 53 MB, 2026-11-27)."""
+    from ._batch import solve_batch as compiled
+
+    return compiled(*args, **kwargs)
+
+
+def solve_compatibility_fast(*args, **kwargs):
+    """:func:`._batch.solve_compatibility_fast`, imported on the first call (as
+    :func:`solve_batch`)."""
+    from ._batch import solve_compatibility_fast as compiled
+
+    return compiled(*args, **kwargs)
 
 
 class FEStiffness:
