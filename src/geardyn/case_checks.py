@@ -20,7 +20,7 @@ physics of its own; each check is the stage's own code:
 4. the load laws (the steady speed and the calibration of the output law of
    :mod:`geardyn.dynamics.model`);
 5. the bounded-work check of the simulation (step count and record size,
-   :func:`geardyn.dynamics.newmark.check_bounded_work`);
+   :func:`geardyn.run_limits.check_bounded_work`);
 6. the model options (:func:`geardyn.dynamics.newmark.check_model_options`: friction needs
    the transverse model, which has no HHT and no load family), the faults the stiffness method cannot model
    (:func:`geardyn.faults.check_method`) and the load family's torques
@@ -113,7 +113,7 @@ def check_case(case, *, cache=None) -> list[str]:
         _check_fe(case, pair, crack)
 
     _check_loads(case, pair)
-    from .dynamics.newmark import check_bounded_work
+    from .run_limits import check_bounded_work
 
     check_bounded_work(case)
     notes = _check_dynamics(case, cache)
@@ -146,7 +146,7 @@ def check_measurement(case):
     geardyn.errors.InputError
         Naming the ``measurement.*`` (or ``simulation.*``) field.
     """
-    from .dynamics.newmark import check_bounded_work
+    from .run_limits import check_bounded_work
     from .studies.measure import chain_from_config, simulated_case
 
     chain = chain_from_config(case.measurement)

@@ -64,3 +64,61 @@ def test_building_the_faulty_bodies_imports_neither_numba_nor_matplotlib(tmp_pat
     assert out.returncode == 0, out.stderr
     # the healthy pinion and gear, the cracked tooth's body (also under "cracked")
     assert out.stdout.strip() == "4 ['cracked', 'gear', 'pinion'] []", out.stdout
+
+
+@pytest.mark.slow
+def test_the_first_process_imports_numba_with_the_contact_problems_only(tmp_path, monkeypatch):
+    """``geardyn run``'s first process, up to the end of its FE bodies (the command's module,
+    its bounded-work check, the FE stage's second-process set-up, the faulty and the healthy
+    bodies, here without a second process), leaves numba unimported: it comes with the contact
+    problems, after the factorisations. A full run hands the kernel's compilation to the
+    bodies' second process by module and name, without asking numba's cache here."""
+    code = textwrap.dedent("""
+        import os, sys
+        import geardyn
+        import geardyn.cli.run
+        from geardyn.cache import Cache
+        from geardyn.run_limits import check_bounded_work
+        from geardyn.stiffness.fe.model import FEStiffness
+        from geardyn.studies.paper import _faulty_bodies_in_background
+        from geardyn.studies.paper_result import StudyResult
+        from geardyn.cli import app
+        # the command up to its last check before the output folder (a bad second-process
+        # setting is refused right after the bounded-work check): exit 2
+        os.environ["GEARDYN_FE_PROCESSES"] = "2"
+        try:
+            app(["run", "--stiffness", "fe", "--out", sys.argv[1]])
+        except SystemExit as exc:
+            print(exc.code)
+        os.environ["GEARDYN_FE_PROCESSES"] = "0"
+        case = geardyn.paper_case().with_overrides({
+            "stiffness.method": "fe", "stiffness.fe.refinement": 0.25})
+        check_bounded_work(case)
+        with _faulty_bodies_in_background(case, StudyResult(out=None)) as bodies:
+            FEStiffness(case, cracked=False)
+        print(bool(bodies), "numba" in sys.modules)
+    """)
+    env = dict(__import__("os").environ, GEARDYN_FE_PROCESSES="0",
+               GEARDYN_CACHE_DIR=str(tmp_path / "cache"))
+    out = subprocess.run([sys.executable, "-c", code, str(tmp_path / "out")],
+                         capture_output=True, text=True, timeout=600, env=env)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split() == ["2", "False", "False"], out.stdout + out.stderr
+
+    # with a second process allowed, what it is asked to do after its bodies
+    from geardyn import paper_case
+    from geardyn.stiffness.fe import background
+    from geardyn.studies import paper
+    from geardyn.studies.paper_result import StudyResult
+
+    seen = {}
+
+    def fake(case, **kw):
+        seen.update(kw)
+        return __import__("contextlib").nullcontext(None)
+
+    monkeypatch.setattr(background, "faulty_bodies_in_background", fake)
+    case = paper_case().with_overrides({"stiffness.method": "fe"})
+    paper._faulty_bodies_in_background(case, StudyResult(out=None))
+    (then,) = seen["then"]
+    assert (then.__module__, then.__qualname__) == ("geardyn.dynamics.warm", "compile_kernels")

@@ -79,7 +79,7 @@ def run(
         _print_summary(summary, target.path)
         return
     from ..cache import record_lookups
-    from ..dynamics.newmark import check_bounded_work
+    from ..run_limits import check_bounded_work
     from ..studies.paper import STAGES, run_paper_study
 
     check_bounded_work(_simulation_case(case, quick))

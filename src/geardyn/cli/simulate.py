@@ -118,9 +118,9 @@ def simulate(
 
     from ..dynamics import save_mat, save_netcdf, summary
     from ..dynamics import simulate as run_simulation
-    from ..dynamics.newmark import check_bounded_work
     from ..errors import NumericalError
     from ..io import read_netcdf
+    from ..run_limits import check_bounded_work
     from ..stiffness import build_map
 
     check_bounded_work(case)

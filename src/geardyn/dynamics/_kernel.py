@@ -89,6 +89,7 @@ import math
 import numba
 import numpy as np
 
+from ..run_limits import RECORD_VARIABLES
 from ..stiffness.map import lookup_box, lookup_box_reference
 
 __all__ = ["advance", "advance_python", "law_torque", "family_lookup", "no_family", "STATUS_TEXT",
@@ -116,7 +117,7 @@ S_FEL = 29  # elastic mesh force of the step: the load a K(theta, d, F) family i
 N_STATE = 30
 # record columns
 R_Z, R_V, R_N, R_DD, R_K, R_H, R_IT, R_RB, R_RA, R_E = 0, 6, 12, 13, 14, 15, 16, 17, 18, 19
-N_REC = 20
+N_REC = RECORD_VARIABLES  # 20: geardyn.run_limits estimates a record's size from it
 # tooth errors (geardyn.modifications): integer and float parameters
 EI_ACTIVE, EI_Z1, EI_Z2, EI_NR, EI_TABLE, EI_RUNOUT, EI_SHARES = range(7)
 N_EIP = 7

@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import GeardynError, InputError, NumericalError
+from ..run_limits import check_bounded_work, check_record_size  # noqa: F401 - re-exported
 from ..stiffness.map import MapArrays, StiffnessMap
 from . import _kernel as K
 from .model import (
@@ -643,13 +644,13 @@ def case_arithmetic(case):
 
 def record_plan(sim) -> tuple[int, int, int, int]:
     """``(n_settle, decimation, records, n_last)`` of ``case.simulation`` (refused when the
-    record would not fit, :func:`_check_record_size`)."""
+    record would not fit, :func:`geardyn.run_limits.check_record_size`)."""
     dt = sim.dt
     n_settle = int(round(sim.settle_time / dt))
     n_record = max(1, int(round(sim.record_time / dt)))
     decim = sim.decimation
     count = -(-n_record // decim)
-    _check_record_size(count, sim)
+    check_record_size(count, sim)
     return n_settle, decim, count, n_settle + (count - 1) * decim
 
 
@@ -719,52 +720,6 @@ def check_model_options(case) -> None:
         raise InputError("mesh.friction_coefficient", case.mesh.friction_coefficient,
                          "0 with simulation.dynamics = '6-dof' (friction acts across the line "
                          "of action: set simulation.dynamics = 'transverse')")
-
-
-def check_bounded_work(case) -> int:
-    """Refuse, before any work, a simulation whose step count or record would not fit.
-
-    The step count is ``(settle_time + record_time) / dt``; it must not exceed
-    ``simulation.max_steps`` (default 1e8, a few minutes to an hour of kernel time;
-    :func:`geardyn.run_limits.check_step_count`). The record must fit in memory (see
-    :func:`_check_record_size`).
-
-    Parameters
-    ----------
-    case : geardyn.config.Case
-
-    Returns
-    -------
-    int
-        Total number of time steps.
-
-    Raises
-    ------
-    InputError
-        Naming the times, the estimate and the limit, and how to raise it.
-    """
-    from ..run_limits import check_step_count
-
-    sim = case.simulation
-    steps = check_step_count(sim)
-    n_record = max(1, int(round(sim.record_time / sim.dt)))
-    _check_record_size(-(-n_record // sim.decimation), sim)
-    return steps
-
-
-def _check_record_size(count: int, sim) -> None:
-    """Refuse a record that would not fit in memory (limit ``$GEARDYN_MAX_RECORD_GB``, default
-    8 GB, about 4 times the record itself once it becomes a Dataset)."""
-    import os
-
-    limit_gb = float(os.environ.get("GEARDYN_MAX_RECORD_GB", "8"))
-    need_gb = 4 * count * K.N_REC * 8 / 1e9
-    if need_gb > limit_gb:
-        raise InputError(
-            "simulation.record_time", sim.record_time,
-            f"a record that fits in memory: {count} samples x {K.N_REC} variables needs about "
-            f"{need_gb:.3g} GB (limit {limit_gb:g} GB, set by GEARDYN_MAX_RECORD_GB); raise "
-            "simulation.decimation, lengthen simulation.dt or shorten simulation.record_time")
 
 
 def _numerical_error(status: int, fail: np.ndarray, stiffness_map: StiffnessMap,

@@ -114,11 +114,20 @@ def _faulty_bodies_in_background(case: Case, result: StudyResult):
 
     if case.stiffness.method != "fe":
         return contextlib.nullcontext(None)
-    from ..dynamics.warm import compile_kernels, kernels_compiled
     from ..stiffness.fe.background import faulty_bodies_in_background, tasks_in_background
 
     progress = result.sub_progress("stiffness (FE bodies)")
-    if result.quick and not kernels_compiled():
+    if not result.quick:
+        # the second process compiles the time-step kernel after its bodies, while this one
+        # evaluates the maps and goes on, or loads it from numba's cache (0.3 s) where it is
+        # there already; asking numba's cache here would import numba (53 MB) into this
+        # process before its own bodies' factorisations, the peak of the run's memory
+        return faulty_bodies_in_background(
+            case, then=(ImportedOnCall("geardyn.dynamics.warm", "compile_kernels"),),
+            progress=progress)
+    from ..dynamics.warm import compile_kernels, kernels_compiled
+
+    if not kernels_compiled():
         # a first --quick run after an install: the second process compiles the time-step kernel
         # (5-10 s) from the start, and this one builds the coarse bodies (a second or two) itself;
         # same-time A/B, 2026-11-26: 24.5-26.2 s and 675 MB against 27.5-28.8 s and 801-807 MB
@@ -129,11 +138,9 @@ def _faulty_bodies_in_background(case: Case, result: StudyResult):
         if result.kernel_compiler is not None:
             result.background.append(result.kernel_compiler)
         return faulty_bodies_in_background(case, progress=progress, second_process=False)
-    # on a first run after an install, the same process then compiles the time-step kernel
-    # while this one evaluates the maps and goes on; with the kernel compiled it ends with the
-    # bodies (loading the kernel there would not load it here) and the block waits for it
-    then = () if kernels_compiled() else (compile_kernels,)
-    return faulty_bodies_in_background(case, then=then, progress=progress)
+    # --quick with the kernel compiled: the second process ends with the bodies (loading the
+    # kernel there would not load it here) and the block waits for it
+    return faulty_bodies_in_background(case, progress=progress)
 
 
 def _figure_process(result: StudyResult):
