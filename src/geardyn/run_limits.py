@@ -17,9 +17,9 @@ __all__ = ["DEFAULT_MAX_STEPS", "RECORD_VARIABLES", "check_step_count", "check_b
 #: Default of ``simulation.max_steps`` [-]: 1e8 steps, minutes to an hour of kernel time.
 DEFAULT_MAX_STEPS = 1e8
 
-#: Variables the time-step kernel records per sample: the record's columns
-#: (``geardyn.dynamics._kernel.N_REC`` takes its value from here), from which a record's size
-#: is estimated before the run.
+#: Variables the time-step kernel records per sample, from which a record's size is estimated
+#: before the run: ``geardyn.dynamics._kernel.N_REC``, the record's columns (that module
+#: refuses to load if they differ).
 RECORD_VARIABLES = 20
 
 

@@ -117,7 +117,12 @@ S_FEL = 29  # elastic mesh force of the step: the load a K(theta, d, F) family i
 N_STATE = 30
 # record columns
 R_Z, R_V, R_N, R_DD, R_K, R_H, R_IT, R_RB, R_RA, R_E = 0, 6, 12, 13, 14, 15, 16, 17, 18, 19
-N_REC = RECORD_VARIABLES  # 20: geardyn.run_limits estimates a record's size from it
+N_REC = 20
+# geardyn.run_limits estimates a record's size before the run without importing this module
+# (numba): the same width there. A literal here, not an import, so that numba's cache, which
+# keys the kernel on this file, sees any change of it
+if N_REC != RECORD_VARIABLES:  # (not an assert: python -O would drop it)
+    raise RuntimeError("geardyn.run_limits.RECORD_VARIABLES differs from the kernel's N_REC")
 # tooth errors (geardyn.modifications): integer and float parameters
 EI_ACTIVE, EI_Z1, EI_Z2, EI_NR, EI_TABLE, EI_RUNOUT, EI_SHARES = range(7)
 N_EIP = 7

@@ -322,7 +322,6 @@ def _rows(cand: Candidates, q: np.ndarray) -> Candidates:
     return Candidates(**{k: getattr(cand, k)[q] for k in Candidates.__dataclass_fields__})
 
 
-
 def solve_batch(*args, **kwargs):
     """:func:`._batch.solve_batch`, imported on the first call: a process that builds FE
     bodies (the second process of :mod:`.background`) does not import numba before its
