@@ -241,11 +241,9 @@ def _dask_client(scheduler: str | None, workers: int | None, client) -> Iterator
     if client is not None:
         yield client
         return
-    import logging
-
-    from distributed import Client, LocalCluster
-
     if scheduler:
+        from distributed import Client
+
         try:
             cl = Client(scheduler, timeout="30s")
         except OSError as exc:
@@ -257,7 +255,18 @@ def _dask_client(scheduler: str | None, workers: int | None, client) -> Iterator
             finally:
                 cl.close()
         return
+    from .local_workers import local_worker_settings
+
     n = workers or os.cpu_count() or 1
+    with local_worker_settings():  # (Linux) forked from a process that imported the run code
+        yield from _local_client(n)
+
+
+def _local_client(n: int) -> Iterator[Any]:
+    import logging
+
+    from distributed import Client, LocalCluster
+
     # distributed's nannies write their workers' variables (OMP_NUM_THREADS=1, PYTHONHASHSEED,
     # MALLOC_TRIM_THRESHOLD_, ...) into this process's environment and leave them: put back
     # what was there once the cluster is closed (a notebook's later subprocesses inherit it)

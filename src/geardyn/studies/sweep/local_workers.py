@@ -1,0 +1,82 @@
+"""The worker processes of a local Dask cluster (``geardyn sweep`` without ``--scheduler``):
+how they start and what they do besides the runs.
+
+*How they start.* Dask's nanny starts each worker with ``multiprocessing``'s *spawn* method by
+default: a fresh interpreter per worker, which imports NumPy, SciPy, xarray, pandas, numba, zarr
+and geardyn's run code itself before its first task (2-3 s of CPU a worker on the 2-core test
+machine). On Linux geardyn starts them with the *forkserver* method instead (Dask's setting
+``distributed.worker.multiprocessing-method``): one server process imports those modules once
+(:mod:`._worker_preload`) and each worker is forked from it, sharing the imported pages
+copy-on-write. The nanny's variables for its workers (``OMP_NUM_THREADS=1``, ...) are in the
+environment before the server starts (Dask sets them before it starts the first worker, and the
+server starts with the first worker), and the worker runs the same code, so a sweep stores the
+same bits either way (``tests/sweep/test_local_workers.py``).
+``GEARDYN_WORKER_START=spawn`` keeps Dask's default; spawn is also what other systems get (on
+macOS, forking after the system's libraries have started threads is not safe; Windows has no
+fork).
+
+*What they do besides the runs.* Each worker samples its own stack every 10 ms for the Dask
+dashboard's profile (``distributed.worker.profile.enabled``); geardyn's local cluster has no
+dashboard, so that is switched off.
+
+Measured on 2026-11-27 (AMD EPYC, 2 cores, ``geardyn sweep
+examples/faults/sweep_spall_width.toml``: four runs on two workers, fresh geardyn cache, numba's
+cache filled; CPU time summed over every process of the command, read from ``/proc``): see
+``docs/performance.md``, "2026-11-27 (08:50-): the sweep's worker processes".
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
+
+__all__ = ["WORKER_PRELOAD", "worker_start_method", "local_worker_settings"]
+
+#: What the forkserver imports before it forks a worker (module names, imported in this order).
+WORKER_PRELOAD = ("distributed", "geardyn.studies.sweep._worker_preload")
+
+_METHODS = ("forkserver", "spawn")
+
+
+def worker_start_method() -> str:
+    """``"forkserver"`` on Linux; ``"spawn"`` elsewhere, or with ``GEARDYN_WORKER_START=spawn``.
+
+    Raises
+    ------
+    geardyn.errors.InputError
+        ``GEARDYN_WORKER_START`` set to something else.
+    """
+    from ...errors import InputError
+
+    asked = os.environ.get("GEARDYN_WORKER_START", "").strip().lower()
+    if asked and asked not in _METHODS:
+        raise InputError("GEARDYN_WORKER_START", asked, " or ".join(_METHODS))
+    if asked == "spawn" or not sys.platform.startswith("linux"):
+        return "spawn"
+    return "forkserver"
+
+
+@contextmanager
+def local_worker_settings() -> Iterator[str]:
+    """Dask's settings for a local cluster's workers, for the ``with`` block (the cluster's
+    lifetime, so that a worker the nanny restarts starts the same way); yields the start method.
+
+    With ``"forkserver"``, the server's preload is :data:`WORKER_PRELOAD`, set after Dask's
+    own list (Dask's dependencies, set once per process); a server already running keeps its
+    preload.
+    """
+    import multiprocessing
+
+    import dask
+    from distributed.utils import get_mp_context
+
+    method = worker_start_method()
+    with dask.config.set({"distributed.worker.multiprocessing-method": method,
+                          "distributed.worker.profile.enabled": False}):
+        if method == "forkserver":
+            get_mp_context()  # Dask's preload first, then geardyn's
+            multiprocessing.get_context("forkserver").set_forkserver_preload(
+                list(WORKER_PRELOAD))
+        yield method

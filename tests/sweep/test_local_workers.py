@@ -1,0 +1,100 @@
+"""The local cluster's worker processes (``geardyn.studies.sweep.local_workers``): forked from a
+server that imported the run code (Linux), or spawned; the same stored bits either way."""
+
+from __future__ import annotations
+
+import os
+import sys
+import textwrap
+
+import numpy as np
+import pytest
+
+from geardyn.errors import InputError
+from geardyn.studies.sweep import open_sweep, run_sweep
+from geardyn.studies.sweep.local_workers import WORKER_PRELOAD, worker_start_method
+
+from .._cli_fork import run_geardyn
+from ._procs import env
+
+LINUX = sys.platform.startswith("linux")
+
+SWEEP = textwrap.dedent("""
+    name = "workers"
+    seed = 4
+    [set]
+    stiffness.method = "pem"
+    stiffness.centre_distances = 6
+    stiffness.nodes_per_segment = 6
+    simulation.record_time = "0.12 s"
+    simulation.settle_time = "0.01 s"
+    [axes]
+    crack.depth = ["1 mm", "3 mm"]
+    motor.torque = ["60 N m", "120 N m"]
+    [execution]
+    batch_size = 1
+""")
+
+
+def _worker_state(cl) -> list[tuple[bool, str]]:
+    """Per worker: was the forkserver's preload imported, and the worker's OMP_NUM_THREADS."""
+    def state():
+        return ("geardyn.studies.sweep._worker_preload" in sys.modules,
+                os.environ.get("OMP_NUM_THREADS", ""))
+    return list(cl.run(state).values())
+
+
+@pytest.mark.skipif(not LINUX, reason="the forkserver start is Linux's")
+def test_workers_fork_from_the_preloaded_server_or_spawn_as_asked(monkeypatch):
+    from geardyn.studies.sweep.execute import _dask_client
+
+    monkeypatch.delenv("GEARDYN_WORKER_START", raising=False)
+    assert worker_start_method() == "forkserver"
+    environ = dict(os.environ)
+    with _dask_client(None, 2, None) as cl:
+        forked = _worker_state(cl)
+        profiling = cl.run(lambda: __import__("dask").config.get(
+            "distributed.worker.profile.enabled"))
+    assert forked == [(True, "1"), (True, "1")], forked  # the nanny's variables arrived too
+    assert set(profiling.values()) == {False}  # no dashboard: no stack sampling every 10 ms
+    monkeypatch.setenv("GEARDYN_WORKER_START", "spawn")
+    with _dask_client(None, 1, None) as cl:
+        assert _worker_state(cl) == [(False, "1")]
+    monkeypatch.delenv("GEARDYN_WORKER_START")
+    assert dict(os.environ) == environ
+    assert WORKER_PRELOAD[-1] == "geardyn.studies.sweep._worker_preload"
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not LINUX, reason="the forkserver start is Linux's")
+def test_forked_and_spawned_workers_store_the_same_bits(tmp_path, monkeypatch):
+    f = tmp_path / "s.toml"
+    f.write_text(SWEEP)
+    stores = {}
+    for method in ("forkserver", "spawn"):
+        monkeypatch.setenv("GEARDYN_WORKER_START", method)
+        stores[method] = tmp_path / f"{method}.zarr"
+        result = run_sweep(f, stores[method], workers=2)
+        assert result.ok == 4 and result.failed == 0, result
+    a, b = (open_sweep(stores[m]).load() for m in ("forkserver", "spawn"))
+    compared = 0
+    for name in a.data_vars:
+        if name in ("run_seconds", "worker", "batch_checksum"):  # how it ran
+            continue
+        np.testing.assert_array_equal(a[name].values, b[name].values, err_msg=name)
+        compared += 1
+    assert compared > 20 and np.isfinite(a["v_yg__FM4"].values).all()
+
+
+def test_an_unknown_start_method_is_refused_by_name(tmp_path, monkeypatch):
+    monkeypatch.setenv("GEARDYN_WORKER_START", "fork")
+    with pytest.raises(InputError) as e:
+        worker_start_method()
+    assert e.value.field == "GEARDYN_WORKER_START" and "forkserver or spawn" in e.value.allowed
+    f = tmp_path / "s.toml"
+    f.write_text(SWEEP)
+    r = run_geardyn(["sweep", str(f), "--out", str(tmp_path / "o.zarr")], capture_output=True,
+                    text=True, env={**env(), "GEARDYN_WORKER_START": "fork"}, timeout=120,
+                    cwd=tmp_path)
+    assert r.returncode == 2, r.stdout + r.stderr
+    assert "GEARDYN_WORKER_START" in r.stderr and "Traceback" not in r.stderr
