@@ -171,8 +171,20 @@ def _tree_rss_kb(root: int, pss: bool = True) -> tuple[int, int | None]:
             sum(_pss_kb(p) for p in tree) if pss else None)
 
 
-def run_measured(cmd: list[str], env: dict, *, interval: float = 0.05, pss_every: int = 10
-                 ) -> tuple[float, float, float, float]:
+def _cpu_seconds(pid: int) -> float | None:
+    """User + system CPU time [s] of ``pid`` so far (``/proc/<pid>/stat``); None if it ended."""
+    import os
+
+    try:
+        with open(f"/proc/{pid}/stat") as fh:
+            fields = fh.read().rsplit(")", 1)[1].split()
+        return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+    except (OSError, IndexError, ValueError):
+        return None
+
+
+def run_measured(cmd: list[str], env: dict, *, interval: float = 0.05, pss_every: int = 10,
+                 cpu_out: list[float] | None = None) -> tuple[float, float, float, float]:
     """Run ``cmd``; return its wall time [s], the peak of the *summed* resident memory of the
     process and its children [MB] (sampled every ``interval`` s from ``/proc``; 0 where there
     is none), its own peak resident set [MB] (``ru_maxrss`` from ``wait4``: the largest single
@@ -184,6 +196,12 @@ def run_measured(cmd: list[str], env: dict, *, interval: float = 0.05, pss_every
     process's proportional set size at every sample, about 15 ms of CPU every 50 ms with three
     processes (a third of a core), which made ``geardyn run --quick`` about 1.6 s (12 %) slower
     than timed alone (measured 2026-11-26, docs/performance.md).
+
+    With ``cpu_out`` (a list), the CPU time [s] of every process of the tree is appended to
+    it: each process's user + system time as last read (every ``interval`` s; a process that
+    ends between two samples loses at most its last ``interval``), summed. That includes
+    processes the command does not wait for (a Dask forkserver and the workers it forks),
+    which ``wait4``'s usage does not.
 
     Raises ``RuntimeError`` with the command's stderr if it fails.
     """
@@ -198,6 +216,8 @@ def run_measured(cmd: list[str], env: dict, *, interval: float = 0.05, pss_every
         p = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=err)
         done = threading.Event()
 
+        cpu: dict[int, float] = {}
+
         def sample() -> None:
             k = 0
             while not done.is_set():
@@ -206,6 +226,11 @@ def run_measured(cmd: list[str], env: dict, *, interval: float = 0.05, pss_every
                     peak[0] = max(peak[0], rss)
                     if pss is not None:
                         peak[1] = max(peak[1], pss)
+                    if cpu_out is not None:
+                        for pid in _tree(p.pid):
+                            seconds = _cpu_seconds(pid)
+                            if seconds is not None:
+                                cpu[pid] = seconds
                 k += 1
                 done.wait(interval)
 
@@ -218,6 +243,8 @@ def run_measured(cmd: list[str], env: dict, *, interval: float = 0.05, pss_every
         if os.waitstatus_to_exitcode(status) != 0:
             err.seek(0)
             raise RuntimeError(f"{' '.join(cmd)} failed:\n{err.read().decode()}")
+    if cpu_out is not None:
+        cpu_out.append(sum(cpu.values()))
     return wall, peak[0] / 1024.0, usage.ru_maxrss / 1024.0, peak[1] / 1024.0
 
 

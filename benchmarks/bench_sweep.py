@@ -66,12 +66,10 @@ def _warm(case) -> float:
 
 
 def run(quick: bool) -> list[Row]:
-    import logging
     import warnings
 
-    from distributed import Client, LocalCluster
-
     from geardyn.studies.sweep import evaluate_run, parse_sweep, run_sweep
+    from geardyn.studies.sweep.execute import _dask_client
 
     n_t, n_k = (4, 4) if quick else (8, 8)
     sweep = parse_sweep(_sweep_text(n_t, n_k))
@@ -97,10 +95,9 @@ def run(quick: bool) -> list[Row]:
         walls: dict[int, float] = {}
         cpus: dict[int, float] = {}
         for workers in (1, 2):
-            cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                                   dashboard_address=None, silence_logs=logging.ERROR)
-            client = Client(cluster)
-            try:
+            # the local cluster `geardyn sweep` starts (its workers' start method and settings:
+            # geardyn.studies.sweep.local_workers)
+            with _dask_client(None, workers, None) as client:
                 client.run(_warm, sweep.base_case)
                 out = tmp / f"w{workers}.zarr"
                 cpu0 = sum(client.run(time.process_time).values())
@@ -122,9 +119,6 @@ def run(quick: bool) -> list[Row]:
                 rows.append(Row(
                     f"  same, end to end incl. template, pilot, map ({res.seconds:.1f} s)",
                     e2e, "runs/core-hour", target="", met=None))
-            finally:
-                client.close()
-                cluster.close()
         eff = walls[1] / (2.0 * walls[2])
         rows.append(Row("sweep scaling efficiency 1 -> 2 workers (run phase)", 100.0 * eff, "%",
                         target=f">= {100 * TARGET_EFFICIENCY:.0f} %",

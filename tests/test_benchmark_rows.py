@@ -78,3 +78,27 @@ def test_memory_of_a_process_tree(tmp_path, monkeypatch):
     finally:
         proc.stdin.close()
         proc.wait(timeout=60)
+
+
+def test_cpu_time_of_a_process_tree_counts_a_child_nobody_waits_for():
+    """``run_measured(cpu_out=...)``: a command that burns 0.4 s of CPU and starts a child that
+    burns 0.4 s and is not waited for (as a Dask forkserver is not) reads the CPU of both: at
+    least 0.8 s less one sampling interval per process, at most that plus two interpreters'
+    start. ``wait4``'s usage would miss the child."""
+    import os
+
+    import pytest
+
+    if not os.path.isdir("/proc"):
+        pytest.skip("no /proc on this system")
+    burn = ("import time\nt = time.process_time()\n"
+            "while time.process_time() - t < 0.4:\n    pass\n")
+    child = burn + "import os, sys\nos.write(int(sys.argv[1]), b'x')\n"
+    code = (f"import os, subprocess, sys\nr, w = os.pipe()\n"
+            f"subprocess.Popen([sys.executable, '-c', {child!r}, str(w)], pass_fds=(w,))\n"
+            f"{burn}"
+            "os.read(r, 1)  # the child has burnt its share; it is left to exit on its own\n")
+    cpu: list[float] = []
+    common.run_measured([sys.executable, "-c", code], dict(os.environ), cpu_out=cpu)
+    assert len(cpu) == 1
+    assert 0.8 - 2 * 0.05 <= cpu[0] <= 0.8 + 2 * 0.5, cpu

@@ -45,11 +45,12 @@ def _worker_state(cl) -> list[tuple[bool, str]]:
 
 
 @pytest.mark.skipif(not LINUX, reason="the forkserver start is Linux's")
-def test_workers_fork_from_the_preloaded_server_or_spawn_as_asked(monkeypatch):
+def test_two_workers_fork_from_the_preloaded_server_one_or_as_asked_spawns(monkeypatch):
     from geardyn.studies.sweep.execute import _dask_client
 
     monkeypatch.delenv("GEARDYN_WORKER_START", raising=False)
-    assert worker_start_method() == "forkserver"
+    assert worker_start_method(2) == "forkserver" and worker_start_method(8) == "forkserver"
+    assert worker_start_method(1) == "spawn"  # one worker: nothing to share
     environ = dict(os.environ)
     with _dask_client(None, 2, None) as cl:
         forked = _worker_state(cl)
@@ -57,11 +58,9 @@ def test_workers_fork_from_the_preloaded_server_or_spawn_as_asked(monkeypatch):
             "distributed.worker.profile.enabled"))
     assert forked == [(True, "1"), (True, "1")], forked  # the nanny's variables arrived too
     assert set(profiling.values()) == {False}  # no dashboard: no stack sampling every 10 ms
-    monkeypatch.setenv("GEARDYN_WORKER_START", "spawn")
-    with _dask_client(None, 1, None) as cl:
-        assert _worker_state(cl) == [(False, "1")]
-    monkeypatch.delenv("GEARDYN_WORKER_START")
     assert dict(os.environ) == environ
+    monkeypatch.setenv("GEARDYN_WORKER_START", "spawn")  # (the slow test spawns two workers)
+    assert worker_start_method(2) == "spawn"
     assert WORKER_PRELOAD[-1] == "geardyn.studies.sweep._worker_preload"
 
 
@@ -75,6 +74,7 @@ def test_forked_and_spawned_workers_store_the_same_bits(tmp_path, monkeypatch):
         monkeypatch.setenv("GEARDYN_WORKER_START", method)
         stores[method] = tmp_path / f"{method}.zarr"
         result = run_sweep(f, stores[method], workers=2)
+        assert result.workers == 2
         assert result.ok == 4 and result.failed == 0, result
     a, b = (open_sweep(stores[m]).load() for m in ("forkserver", "spawn"))
     compared = 0
@@ -89,12 +89,12 @@ def test_forked_and_spawned_workers_store_the_same_bits(tmp_path, monkeypatch):
 def test_an_unknown_start_method_is_refused_by_name(tmp_path, monkeypatch):
     monkeypatch.setenv("GEARDYN_WORKER_START", "fork")
     with pytest.raises(InputError) as e:
-        worker_start_method()
+        worker_start_method(2)
     assert e.value.field == "GEARDYN_WORKER_START" and "forkserver or spawn" in e.value.allowed
     f = tmp_path / "s.toml"
     f.write_text(SWEEP)
-    r = run_geardyn(["sweep", str(f), "--out", str(tmp_path / "o.zarr")], capture_output=True,
-                    text=True, env={**env(), "GEARDYN_WORKER_START": "fork"}, timeout=120,
-                    cwd=tmp_path)
+    r = run_geardyn(["sweep", str(f), "--out", str(tmp_path / "o.zarr"), "--workers", "2"],
+                    capture_output=True, text=True, env={**env(), "GEARDYN_WORKER_START": "fork"},
+                    timeout=120, cwd=tmp_path)
     assert r.returncode == 2, r.stdout + r.stderr
     assert "GEARDYN_WORKER_START" in r.stderr and "Traceback" not in r.stderr

@@ -258,7 +258,7 @@ def _dask_client(scheduler: str | None, workers: int | None, client) -> Iterator
     from .local_workers import local_worker_settings
 
     n = workers or os.cpu_count() or 1
-    with local_worker_settings():  # (Linux) forked from a process that imported the run code
+    with local_worker_settings(n):  # Linux, 2+ workers: forked from a preloaded process
         yield from _local_client(n)
 
 

@@ -4,13 +4,14 @@ how they start and what they do besides the runs.
 *How they start.* Dask's nanny starts each worker with ``multiprocessing``'s *spawn* method by
 default: a fresh interpreter per worker, which imports NumPy, SciPy, xarray, pandas, numba, zarr
 and geardyn's run code itself before its first task (2-3 s of CPU a worker on the 2-core test
-machine). On Linux geardyn starts them with the *forkserver* method instead (Dask's setting
-``distributed.worker.multiprocessing-method``): one server process imports those modules once
-(:mod:`._worker_preload`) and each worker is forked from it, sharing the imported pages
-copy-on-write. The nanny's variables for its workers (``OMP_NUM_THREADS=1``, ...) are in the
-environment before the server starts (Dask sets them before it starts the first worker, and the
-server starts with the first worker), and the worker runs the same code, so a sweep stores the
-same bits either way (``tests/sweep/test_local_workers.py``).
+machine). On Linux, with two workers or more, geardyn starts them with the *forkserver* method
+instead (Dask's setting ``distributed.worker.multiprocessing-method``): one server process
+imports those modules once (:mod:`._worker_preload`) and each worker is forked from it, sharing
+the imported pages copy-on-write. The nanny's variables for its workers
+(``OMP_NUM_THREADS=1``, ...) are in the environment before the server starts (Dask sets them
+before it starts the first worker, and the server starts with the first worker), and the worker
+runs the same code, so a sweep stores the same bits either way
+(``tests/sweep/test_local_workers.py``). One worker is spawned: there is nothing to share.
 ``GEARDYN_WORKER_START=spawn`` keeps Dask's default; spawn is also what other systems get (on
 macOS, forking after the system's libraries have started threads is not safe; Windows has no
 fork).
@@ -40,8 +41,16 @@ WORKER_PRELOAD = ("distributed", "geardyn.studies.sweep._worker_preload")
 _METHODS = ("forkserver", "spawn")
 
 
-def worker_start_method() -> str:
-    """``"forkserver"`` on Linux; ``"spawn"`` elsewhere, or with ``GEARDYN_WORKER_START=spawn``.
+def worker_start_method(n_workers: int = 2) -> str:
+    """``"forkserver"`` on Linux for two workers or more; ``"spawn"`` for one worker (there is
+    nothing to share, and the server would import, before the worker starts, what a worker of
+    that sweep may not need: 2.3 s against 1.3 s for a small sweep's one worker, measured
+    2026-11-27), on other systems, or with ``GEARDYN_WORKER_START=spawn``.
+
+    Parameters
+    ----------
+    n_workers : int
+        Workers of the local cluster.
 
     Raises
     ------
@@ -53,15 +62,16 @@ def worker_start_method() -> str:
     asked = os.environ.get("GEARDYN_WORKER_START", "").strip().lower()
     if asked and asked not in _METHODS:
         raise InputError("GEARDYN_WORKER_START", asked, " or ".join(_METHODS))
-    if asked == "spawn" or not sys.platform.startswith("linux"):
+    if asked == "spawn" or n_workers < 2 or not sys.platform.startswith("linux"):
         return "spawn"
     return "forkserver"
 
 
 @contextmanager
-def local_worker_settings() -> Iterator[str]:
-    """Dask's settings for a local cluster's workers, for the ``with`` block (the cluster's
-    lifetime, so that a worker the nanny restarts starts the same way); yields the start method.
+def local_worker_settings(n_workers: int) -> Iterator[str]:
+    """Dask's settings for a local cluster of ``n_workers`` workers, for the ``with`` block (the
+    cluster's lifetime, so that a worker the nanny restarts starts the same way); yields the
+    start method (:func:`worker_start_method`).
 
     With ``"forkserver"``, the server's preload is :data:`WORKER_PRELOAD`, set after Dask's
     own list (Dask's dependencies, set once per process); a server already running keeps its
@@ -72,7 +82,7 @@ def local_worker_settings() -> Iterator[str]:
     import dask
     from distributed.utils import get_mp_context
 
-    method = worker_start_method()
+    method = worker_start_method(n_workers)
     with dask.config.set({"distributed.worker.multiprocessing-method": method,
                           "distributed.worker.profile.enabled": False}):
         if method == "forkserver":
