@@ -9,10 +9,14 @@ import pytest
 def client():
     """An in-process Dask cluster (threads): the scheduler and task code paths of a process
     cluster, without the start-up time."""
+    import dask
     from distributed import Client, LocalCluster
 
-    cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=False,
-                           dashboard_address=None)
+    # without the workers' stack sampling every 10 ms, as geardyn's own local cluster
+    # (geardyn.studies.sweep.local_workers): no dashboard shows it
+    with dask.config.set({"distributed.worker.profile.enabled": False}):
+        cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=False,
+                               dashboard_address=None)
     cl = Client(cluster)
     yield cl
     cl.close()
