@@ -28,11 +28,13 @@ def env() -> dict[str, str]:
     return e
 
 
-def start(args: list[str], cwd: Path, log: Path) -> subprocess.Popen:
-    """Start a process in its own session (its group can be killed as a whole)."""
+def start(args: list[str], cwd: Path, log: Path,
+          extra_env: dict[str, str] | None = None) -> subprocess.Popen:
+    """Start a process in its own session (its group can be killed as a whole), with
+    :func:`env` and ``extra_env``."""
     fh = open(log, "wb")  # noqa: SIM115 - closed when the process is stopped
-    p = subprocess.Popen(args, cwd=cwd, env=env(), stdout=fh, stderr=subprocess.STDOUT,
-                         start_new_session=True)
+    p = subprocess.Popen(args, cwd=cwd, env={**env(), **(extra_env or {})}, stdout=fh,
+                         stderr=subprocess.STDOUT, start_new_session=True)
     p._log = fh  # type: ignore[attr-defined]
     return p
 

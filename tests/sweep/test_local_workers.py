@@ -4,8 +4,11 @@ server that imported the run code (Linux), or spawned; the same stored bits eith
 from __future__ import annotations
 
 import os
+import signal
+import subprocess
 import sys
 import textwrap
+import time
 
 import numpy as np
 import pytest
@@ -15,7 +18,7 @@ from geardyn.studies.sweep import open_sweep, run_sweep
 from geardyn.studies.sweep.local_workers import WORKER_PRELOAD, worker_start_method
 
 from .._cli_fork import run_geardyn
-from ._procs import env
+from ._procs import GEARDYN, env, start, stop
 
 LINUX = sys.platform.startswith("linux")
 
@@ -98,3 +101,64 @@ def test_an_unknown_start_method_is_refused_by_name(tmp_path, monkeypatch):
                     timeout=120, cwd=tmp_path)
     assert r.returncode == 2, r.stdout + r.stderr
     assert "GEARDYN_WORKER_START" in r.stderr and "Traceback" not in r.stderr
+
+
+def _session(pid: int) -> list[int]:
+    out = subprocess.run(["pgrep", "-s", str(pid)], capture_output=True, text=True).stdout
+    return [int(x) for x in out.split()]
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not LINUX, reason="the forkserver start is Linux's")
+def test_ctrl_c_while_the_forked_workers_start_is_honoured_without_tracebacks(tmp_path):
+    """A terminal's Ctrl-C (SIGINT to the whole group) while the cluster starts (the command's
+    main thread holds SIGINT back, as ``/proc`` shows; the forkserver is still importing): the
+    command stops with the usual line and exit status once the cluster is up (the Ctrl-C is
+    held, not lost: SIGINT used to be ignored in that window, and the sweep then ran to its
+    end), no process prints a traceback (the forkserver and its workers ignore SIGINT from
+    their start), and nothing of the session is left running."""
+    f = tmp_path / "s.toml"
+    f.write_text(SWEEP)
+    log, ready = tmp_path / "sweep.log", tmp_path / "ready"
+    p = start([*GEARDYN, "sweep", str(f), "--out", str(tmp_path / "o.zarr"), "--workers", "2"],
+              tmp_path, log, extra_env={"GEARDYN_TEST_READY_FILE": str(ready)})
+    try:
+        t0 = time.monotonic()
+        while not (ready.exists() and "local cluster starting" in ready.read_text()):
+            assert p.poll() is None, log.read_text()
+            assert time.monotonic() - t0 < 120, "the cluster's start was not seen"
+            time.sleep(0.005)
+        # the forkserver imports for about 2 s before it forks the first worker
+        assert any("multiprocessing.forkserver" in _cmdline(k) for k in _session(p.pid))
+        assert _sigint_held_back(p.pid)  # held, not ignored
+        os.killpg(p.pid, signal.SIGINT)
+        assert p.wait(timeout=120) in (130, -signal.SIGINT), log.read_text()
+        text = log.read_text()
+        assert "re-run the same command" in text, text
+        assert "Traceback" not in text and "Exception ignored" not in text, text
+        deadline = time.monotonic() + 30  # the forkserver ends when it sees its parent gone
+        while _session(p.pid) and time.monotonic() < deadline:
+            time.sleep(0.1)
+        assert not _session(p.pid), [_cmdline(k) for k in _session(p.pid)]
+    finally:
+        stop(p, signal.SIGKILL)
+
+
+def _sigint_held_back(pid: int) -> bool:
+    """SIGINT blocked in ``pid``'s main thread and not ignored by the process (``/proc``): a
+    Ctrl-C now is delivered later, not lost."""
+    try:
+        with open(f"/proc/{pid}/task/{pid}/status") as fh:
+            fields = dict(line.split(":", 1) for line in fh if ":" in line)
+    except OSError:
+        return False
+    bit = 1 << (signal.SIGINT - 1)
+    return bool(int(fields["SigBlk"], 16) & bit and not int(fields["SigIgn"], 16) & bit)
+
+
+def _cmdline(pid: int) -> str:
+    try:
+        with open(f"/proc/{pid}/cmdline") as fh:
+            return fh.read().replace("\0", " ")
+    except OSError:
+        return ""

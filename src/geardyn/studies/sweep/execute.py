@@ -258,46 +258,85 @@ def _dask_client(scheduler: str | None, workers: int | None, client) -> Iterator
     from .local_workers import local_worker_settings
 
     n = workers or os.cpu_count() or 1
-    with local_worker_settings(n):  # Linux, 2+ workers: forked from a preloaded process
-        yield from _local_client(n)
-
-
-def _local_client(n: int) -> Iterator[Any]:
-    import logging
-
-    from distributed import Client, LocalCluster
-
     # distributed's nannies write their workers' variables (OMP_NUM_THREADS=1, PYTHONHASHSEED,
-    # MALLOC_TRIM_THRESHOLD_, ...) into this process's environment and leave them: put back
-    # what was there once the cluster is closed (a notebook's later subprocesses inherit it)
+    # MALLOC_TRIM_THRESHOLD_, ...) into this process's environment and leave them (and so does
+    # the forkserver's start): put back what was there once the cluster is closed (a
+    # notebook's later subprocesses inherit it)
     environ = dict(os.environ)
-    # the worker processes ignore Ctrl-C (SIGINT reaches the whole terminal process group):
-    # this process cancels the tasks and closes the cluster, with no traceback from each worker
-    main = threading.current_thread() is threading.main_thread()
-    old = signal.signal(signal.SIGINT, signal.SIG_IGN) if main else None
     try:
-        # no dashboard, and the scheduler's HTTP server (health, metrics) on a free port of
-        # this host: with dashboard_address=None it asks for 8787 and Dask warns "Port 8787 is
-        # already in use" whenever another Dask runs here
-        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                               dashboard_address="127.0.0.1:0",
-                               scheduler_kwargs={"dashboard": False},
-                               silence_logs=logging.ERROR)
-    finally:
-        if main:
-            signal.signal(signal.SIGINT, old)
-    cl = Client(cluster)
-    try:
-        with _loop_logs_held():  # the shutdown included
-            try:
-                yield cl
-            finally:
-                cl.close()
-                cluster.close()
+        with local_worker_settings(n) as method:  # Linux, 2+ workers: forked, preloaded
+            yield from _local_client(n, method)
     finally:
         for key in set(os.environ) - set(environ):
             del os.environ[key]
         os.environ.update(environ)
+
+
+@contextlib.contextmanager
+def _interrupts_deferred(forked: bool) -> Iterator[None]:
+    """Ctrl-C and the local cluster's start (the main thread only: signals are its business).
+
+    SIGINT reaches the whole terminal process group; the worker processes must never act on it
+    (this process cancels the tasks and closes the cluster, with no traceback from each worker).
+    Workers forked by the forkserver (``forked``) inherit the server's disposition, ignored from
+    its start (:func:`.local_workers._start_forkserver`), so this process only holds a Ctrl-C
+    pressed while the cluster and its client are made (SIGINT blocked in this thread) and gets
+    it when the block ends, as a ``KeyboardInterrupt`` with both to close. Spawned workers
+    inherit the disposition at their start (a blocked signal mask does not reach a spawned
+    interpreter), so SIGINT is ignored in this process meanwhile, as before, and a Ctrl-C
+    pressed then is lost (0.7 s of a two-worker start here), as it is where threads cannot
+    block signals. Until 2026-11-27 the client was made after this window, and a Ctrl-C during
+    its construction printed "IOLoop is closed" tracebacks from its finaliser."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    if forked and hasattr(signal, "pthread_sigmask"):
+        old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+        try:
+            yield
+        finally:
+            signal.pthread_sigmask(signal.SIG_SETMASK, old)  # a pending Ctrl-C arrives here
+        return
+    handler = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, handler)
+
+
+def _note_for_tests(line: str) -> None:
+    """Append ``line`` to ``$GEARDYN_TEST_READY_FILE`` when it is set (as the CLI's stages
+    do: the interrupt tests wait on it instead of sleeping)."""
+    ready = os.environ.get("GEARDYN_TEST_READY_FILE")
+    if ready:
+        with open(ready, "a", encoding="utf-8") as fh:
+            fh.write(line + "\n")
+
+
+def _local_client(n: int, method: str) -> Iterator[Any]:
+    import logging
+
+    from distributed import Client, LocalCluster
+
+    cluster = cl = None
+    with _loop_logs_held():  # the start and the shutdown included
+        try:
+            with _interrupts_deferred(method == "forkserver"):  # (workers never see it)
+                _note_for_tests("sweep: local cluster starting")
+                # no dashboard, and the scheduler's HTTP server (health, metrics) on a free
+                # port of this host: with dashboard_address=None it asks for 8787 and Dask
+                # warns "Port 8787 is already in use" whenever another Dask runs here
+                cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                                       dashboard_address="127.0.0.1:0",
+                                       scheduler_kwargs={"dashboard": False},
+                                       silence_logs=logging.ERROR)
+                cl = Client(cluster)
+            yield cl
+        finally:
+            if cl is not None:
+                cl.close()
+            if cluster is not None:
+                cluster.close()
 
 
 def run_sweep(

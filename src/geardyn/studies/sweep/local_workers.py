@@ -89,4 +89,37 @@ def local_worker_settings(n_workers: int) -> Iterator[str]:
             get_mp_context()  # Dask's preload first, then geardyn's
             multiprocessing.get_context("forkserver").set_forkserver_preload(
                 list(WORKER_PRELOAD))
+            _start_forkserver()
         yield method
+
+
+def _start_forkserver() -> None:
+    """Start the forkserver now (a no-op when it runs already), ignoring Ctrl-C from its first
+    instruction, with the variables Dask's nanny sets for its workers.
+
+    The server keeps the disposition it was started with and gives it to every worker it
+    forks, so the workers never act on a terminal's Ctrl-C (the first process cancels the
+    tasks and closes the cluster) however the first process treats SIGINT when they are
+    forked. Dask's nanny would start the server with its first worker, with
+    ``distributed.nanny.pre-spawn-environ`` (``OMP_NUM_THREADS=1``, ...: variables a library
+    reads when it is loaded, so they must be in place before the server imports NumPy) already
+    in the environment; they are put there here the same way (a variable already set keeps its
+    value, as Dask documents), and the caller's environment is restored when the cluster is
+    closed (:func:`geardyn.studies.sweep.execute._local_client`).
+    """
+    import multiprocessing.forkserver
+    import signal
+    import threading
+
+    import dask
+
+    for key, value in dask.config.get("distributed.nanny.pre-spawn-environ").items():
+        if value is not None:
+            os.environ.setdefault(key, str(value))
+    main = threading.current_thread() is threading.main_thread()
+    old = signal.signal(signal.SIGINT, signal.SIG_IGN) if main else None
+    try:
+        multiprocessing.forkserver.ensure_running()
+    finally:
+        if main:
+            signal.signal(signal.SIGINT, old)
