@@ -23,7 +23,8 @@ dashboard, so that is switched off.
 Measured on 2026-11-27 (AMD EPYC, 2 cores, ``geardyn sweep
 examples/faults/sweep_spall_width.toml``: four runs on two workers, fresh geardyn cache, numba's
 cache filled; CPU time summed over every process of the command, read from ``/proc``): see
-``docs/performance.md``, "2026-11-27 (08:50-): the sweep's worker processes".
+``docs/performance.md``, "2026-11-27 (08:50-10:30): the sweep's worker processes; the
+suite's CPU".
 """
 
 from __future__ import annotations
