@@ -28,7 +28,7 @@ def _preload() -> None:
         try:
             importlib.import_module(name)
         except ImportError:  # an optional library missing: the worker imports what it needs
-            pass
+            continue
     try:
         from numba.core.registry import cpu_target
 

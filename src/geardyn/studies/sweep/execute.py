@@ -285,8 +285,8 @@ def _interrupts_deferred(forked: bool) -> Iterator[None]:
     inherit the disposition at their start (a blocked signal mask does not reach a spawned
     interpreter), so SIGINT is ignored in this process meanwhile, as before, and a Ctrl-C
     pressed then is lost (0.7 s of a two-worker start here), as it is where threads cannot
-    block signals. Until 2026-11-27 the client was made after this window, and a Ctrl-C during
-    its construction printed "IOLoop is closed" tracebacks from its finaliser."""
+    block signals (and one just after it can make the spawned workers print "Exception ignored
+    in Client.__del__" at their exit: seen at 1.3-1.9 s on 2026-11-27, not mended)."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return

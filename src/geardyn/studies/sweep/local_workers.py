@@ -106,7 +106,7 @@ def _start_forkserver() -> None:
     reads when it is loaded, so they must be in place before the server imports NumPy) already
     in the environment; they are put there here the same way (a variable already set keeps its
     value, as Dask documents), and the caller's environment is restored when the cluster is
-    closed (:func:`geardyn.studies.sweep.execute._local_client`).
+    closed (:func:`geardyn.studies.sweep.execute._dask_client`).
     """
     import multiprocessing.forkserver
     import signal
