@@ -47,6 +47,10 @@ def _worker_state(cl) -> list[tuple[bool, str]]:
     return list(cl.run(state).values())
 
 
+def _trim_threshold(cl) -> set:
+    return set(cl.run(lambda: os.environ.get("MALLOC_TRIM_THRESHOLD_")).values())
+
+
 @pytest.mark.skipif(not LINUX, reason="the forkserver start is Linux's")
 def test_two_workers_fork_from_the_preloaded_server_one_or_as_asked_spawns(monkeypatch):
     from geardyn.studies.sweep.execute import _dask_client
@@ -54,13 +58,16 @@ def test_two_workers_fork_from_the_preloaded_server_one_or_as_asked_spawns(monke
     monkeypatch.delenv("GEARDYN_WORKER_START", raising=False)
     assert worker_start_method(2) == "forkserver" and worker_start_method(8) == "forkserver"
     assert worker_start_method(1) == "spawn"  # one worker: nothing to share
+    monkeypatch.delenv("MALLOC_TRIM_THRESHOLD_", raising=False)
     environ = dict(os.environ)
     with _dask_client(None, 2, None) as cl:
         forked = _worker_state(cl)
+        trim = _trim_threshold(cl)
         profiling = cl.run(lambda: __import__("dask").config.get(
             "distributed.worker.profile.enabled"))
     assert forked == [(True, "1"), (True, "1")], forked  # the nanny's variables arrived too
     assert set(profiling.values()) == {False}  # no dashboard: no stack sampling every 10 ms
+    assert trim == {None}  # glibc left to keep a run's freed memory for the next run
     assert dict(os.environ) == environ
     monkeypatch.setenv("GEARDYN_WORKER_START", "spawn")  # (the slow test spawns two workers)
     assert worker_start_method(2) == "spawn"
