@@ -215,3 +215,53 @@ def test_auto_batch_size_and_unstack(tmp_path, client):
     grid = open_sweep(out, unstack=True)
     assert dict(grid["x__amplitude"].sizes) == {"motor.torque": 3, "pinion.bore_radius": 2}
     assert open_sweep(out, only_ok=True).sizes["run"] == 3
+
+
+@pytest.mark.parametrize("in_a_loop", [False, True])
+def test_a_batch_rewritten_whole_or_in_part_keeps_its_checksum(tmp_path, client, in_a_loop):
+    """``_write_batch`` writes a batch's chunks through zarr's asynchronous API on an event
+    loop of its own: from a plain thread (a Dask task) and from inside a running loop (which
+    it must not reuse), a whole batch and a part of one store the given values, keep the
+    other runs, and leave a checksum that verifies."""
+    import asyncio
+
+    from geardyn.studies.sweep.store import RunRecord, _outputs_from_store, _write_batch
+
+    sw = osc_sweep()
+    out = tmp_path / "s.zarr"
+    run_sweep(sw, out, client=client, evaluate=OscillatorEvaluator(torque_limit=LIMIT))
+    before = open_sweep(out).load()
+    outputs = _outputs_from_store(out)
+
+    def record(r: int, value: float) -> RunRecord:
+        values = {o.name: np.full(o.shape, value + r) for o in outputs}
+        return RunRecord(STATUS_OK, values, "", "rewritten", 0.5, "test:1")
+
+    whole = {r: record(r, 1000.0) for r in range(5, 10)}  # batch 1: runs 5-9
+    part = {10: record(10, 2000.0)}  # batch 2 has runs 10 and 11: only run 10
+
+    def write() -> None:
+        _write_batch(str(out), 5, 10, whole, outputs, 5)
+        _write_batch(str(out), 10, 12, part, outputs, 5)
+
+    if in_a_loop:
+        async def main() -> None:
+            write()
+
+        asyncio.run(main())
+    else:
+        write()
+    after = open_sweep(out, verify=True).load()  # verify: every batch's checksum holds
+    for name in ("x__amplitude", "x__static", "x__wave", "noise"):
+        old, new = before[name].values, after[name].values
+        np.testing.assert_array_equal(new[:5], old[:5])  # batch 0 untouched
+        for r in range(5, 10):
+            np.testing.assert_array_equal(new[r], np.full(old.shape[1:], 1000.0 + r))
+        np.testing.assert_array_equal(new[10], np.full(old.shape[1:], 2010.0))
+        np.testing.assert_array_equal(new[11], old[11])  # the run not rewritten is kept
+    assert list(after.status.values[5:11]) == [STATUS_OK] * 6
+    assert after.status.values[11] == before.status.values[11]
+    assert list(after.warning.values[5:11]) == ["rewritten"] * 6
+    assert list(after.worker.values[5:11]) == ["test:1"] * 6
+    np.testing.assert_array_equal(after.run_seconds.values[5:11], 0.5)
+    assert after.warning.values[11] == before.warning.values[11]

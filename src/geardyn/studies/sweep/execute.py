@@ -88,7 +88,8 @@ def _run_batch(ctx: _Context, chunk: int, items: list[tuple[int, dict, int]]) ->
     results = {run: _evaluate_one(ctx.base_case, ov, ctx.evaluator, seed, ctx.outputs)
                for run, ov, seed in items}
     start = chunk * ctx.batch
-    _write_batch(ctx.out, start, min(start + ctx.batch, ctx.n_runs), results, ctx.outputs)
+    _write_batch(ctx.out, start, min(start + ctx.batch, ctx.n_runs), results, ctx.outputs,
+                 ctx.batch)
     ok = sum(1 for r in results.values() if r.status == STATUS_OK)
     return {"chunk": chunk, "ok": ok, "failed": len(results) - ok}
 

@@ -12,7 +12,8 @@ either the old one or the new one. A task writes its data chunks first, then the
 checksum (:mod:`.integrity`), and the status chunk last: a batch killed in between is still
 pending and is redone with the same values; a finished batch whose chunks were later deleted,
 garbled or swapped fails its checksum on resume and is redone too. Only zarr's public API is
-used (``zarr.open_group`` and array slicing). Stale
+used (``zarr.open_group`` and array slicing; a batch's chunks through
+``zarr.api.asynchronous``, all at once). Stale
 ``*.partial`` files are removed when a sweep resumes. With a store that does not write
 atomically the design degrades gracefully: a torn data chunk belongs to a batch whose status was
 never written (so it is redone), and a torn (undecodable) status chunk counts as pending. Writes
@@ -265,19 +266,16 @@ _RUN_VARS: dict[str, tuple[str, Any, dict]] = {
 
 
 def _write_batch(out: str, start: int, stop: int, results: Mapping[int, RunRecord],
-                 outputs: Sequence[Output]) -> None:
-    """Write one chunk ``[start, stop)``: data variables first, then the batch's checksum, the
-    status last.
+                 outputs: Sequence[Output], batch_size: int) -> None:
+    """Write one chunk ``[start, stop)`` (``start`` a multiple of the store's ``batch_size``):
+    data variables first, then the batch's checksum, the status last.
 
     ``results`` maps run -> :class:`RunRecord` for the runs computed; the other runs of the
     chunk keep their stored values (a resumed chunk). The chunks of the data variables are
-    written concurrently from a few threads through zarr's public synchronous API; the checksum
+    written concurrently (:func:`_write_in_order`); the checksum
     (:func:`.integrity.batch_digest` of every value of the chunk, the status included) is
     written once all of them are in place, and the status chunk after it.
     """
-    from concurrent.futures import ThreadPoolExecutor
-
-    g = open_store_group(out, "r+")
     full = len(results) == stop - start
     n = stop - start
     specs: list[tuple[str, tuple, Any, Any, Callable[[RunRecord], Any]]] = [
@@ -286,31 +284,61 @@ def _write_batch(out: str, start: int, stop: int, results: Mapping[int, RunRecor
     specs += [(name, (), dtype, fill,
                lambda rec, name=name: getattr(rec, "seconds" if name == "run_seconds" else name))
               for name, (dtype, fill, _) in _RUN_VARS.items()]
-    arrays = [g[name] for name, *_ in specs]
-    status_arr = g["status"]
     if full:
         blocks = [np.full((n, *shape), fill, dtype=dtype) for _, shape, dtype, fill, _ in specs]
         status = np.full(n, STATUS_PENDING, dtype=np.int8)
     else:  # keep the runs of the chunk that are not recomputed
-        blocks = [np.array(a[start:stop], dtype=sp[2]) for a, sp in zip(arrays, specs, strict=True)]
-        status = np.array(status_arr[start:stop], dtype=np.int8)
+        g = open_store_group(out, "r")
+        blocks = [np.array(g[sp[0]][start:stop], dtype=sp[2]) for sp in specs]
+        status = np.array(g["status"][start:stop], dtype=np.int8)
     for blk, (_, _, _, _, get) in zip(blocks, specs, strict=True):
         for run, rec in results.items():
             blk[run - start] = get(rec)
     for run, rec in results.items():
         status[run - start] = rec.status
-
-    def put(item) -> None:
-        arr, blk = item
-        arr[start:stop] = blk
-
-    with ThreadPoolExecutor(max_workers=min(8, len(arrays))) as pool:
-        list(pool.map(put, zip(arrays, blocks, strict=True)))
     columns = {sp[0]: blk for sp, blk in zip(specs, blocks, strict=True)} | {"status": status}
-    batch = start // status_arr.chunks[0]
-    g[CHECKSUM_VAR][batch:batch + 1] = np.array([batch_digest(start, stop, columns)],
-                                                dtype=f"<U{CHECKSUM_CHARS}")
-    status_arr[start:stop] = status  # last: the batch is done from here
+    batch = start // batch_size
+    region = slice(start, stop)
+    digest = np.array([batch_digest(start, stop, columns)], dtype=f"<U{CHECKSUM_CHARS}")
+    _write_in_order(out, [(sp[0], region, blk) for sp, blk in zip(specs, blocks, strict=True)],
+                    [(CHECKSUM_VAR, slice(batch, batch + 1), digest),
+                     ("status", region, status)])  # last: the batch is done from here
+
+
+def _write_in_order(out: str, together: Sequence[tuple[str, slice, np.ndarray]],
+                    then: Sequence[tuple[str, slice, np.ndarray]]) -> None:
+    """Write the regions ``together`` all at once, then each of ``then`` in turn, once the
+    previous one is in place.
+
+    One event loop does it through zarr's asynchronous API (``zarr.api.asynchronous.open_group``,
+    ``AsyncGroup.getitem``, ``AsyncArray.setitem``), so every chunk of ``together`` is encoded
+    and written concurrently. zarr's synchronous API makes one round trip to its I/O thread per
+    array: for a 13-run batch of the paper's case (76 arrays) that took 0.092-0.095 s from
+    eight threads, against 0.057-0.060 s here (2026-11-27, AMD EPYC, 2 cores).
+    """
+    import asyncio
+
+    from zarr.api import asynchronous as zarr_async
+
+    async def write() -> None:
+        g = await zarr_async.open_group(out, mode="r+",
+                                        use_consolidated=True if _consolidated_ok(Path(out))
+                                        else False)
+        arrays = await asyncio.gather(*(g.getitem(name) for name, _, _ in together))
+        await asyncio.gather(*(a.setitem(sel, value)
+                               for a, (_, sel, value) in zip(arrays, together, strict=True)))
+        for name, sel, value in then:
+            await (await g.getitem(name)).setitem(sel, value)
+
+    try:
+        asyncio.get_running_loop()
+    except RuntimeError:  # no loop in this thread (a Dask task's thread): the usual case
+        asyncio.run(write())
+        return
+    from concurrent.futures import ThreadPoolExecutor
+
+    with ThreadPoolExecutor(max_workers=1) as pool:  # called from a coroutine: its own thread
+        pool.submit(asyncio.run, write()).result()
 
 
 def _clip(text: str, n: int = ERROR_CHARS) -> str:
