@@ -130,3 +130,16 @@ def test_builds_the_case_map_when_none_is_given():
         warnings.simplefilter("ignore")      # the Sainsot range note of the paper's teeth
         ds = simulate(c, model="II", cracked=False)
     assert ds.attrs["stiffness_method"] == "pem" and ds.attrs["stiffness_cracked"] == 0
+
+
+def test_mesh_deflection_is_the_projection_of_the_recorded_coordinates(ds, case, smap):
+    """``mesh_deflection`` (eq. 15, p = g . z) against the recorded coordinates: the record adds
+    the reference rotation to the angles, which g cancels (g . e = 0), so the projection of the
+    recorded values equals it to the rounding of the reference angles."""
+    g = DynamicModel.from_case(case, smap).g
+    coords = np.stack([ds[v].values for v in STATE[:6]], axis=1)  # [rad, m, rad, m, rad, rad]
+    p = coords @ g
+    scale = np.abs(coords) @ np.abs(g)  # [m]: the largest terms of the sum
+    assert np.ptp(ds.mesh_deflection.values) > 1e-3 * np.max(np.abs(ds.mesh_deflection.values))
+    np.testing.assert_allclose(ds.mesh_deflection.values, p, rtol=0,
+                               atol=16 * np.finfo(float).eps * scale.max())

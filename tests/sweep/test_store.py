@@ -265,3 +265,37 @@ def test_a_batch_rewritten_whole_or_in_part_keeps_its_checksum(tmp_path, client,
     assert list(after.worker.values[5:11]) == ["test:1"] * 6
     np.testing.assert_array_equal(after.run_seconds.values[5:11], 0.5)
     assert after.warning.values[11] == before.warning.values[11]
+
+
+def test_a_store_created_again_at_the_same_path_is_opened_afresh(tmp_path, client):
+    """The arrays ``_write_batch`` keeps open between batches belong to one version of the
+    store: after the store is deleted and created again with another batch size, a write goes
+    to the new chunks (a stale array would write chunks of 5 runs where the store has 4)."""
+    import shutil
+
+    from geardyn.studies.sweep.store import RunRecord, _outputs_from_store, _write_batch
+
+    out = tmp_path / "s.zarr"
+    ev = OscillatorEvaluator(torque_limit=LIMIT)
+    run_sweep(osc_sweep(), out, client=client, evaluate=ev)  # batch_size 5
+    outputs = _outputs_from_store(out)
+
+    def records(runs, value: float) -> dict:
+        return {r: RunRecord(STATUS_OK, {o.name: np.full(o.shape, value + r) for o in outputs},
+                             "", "rewritten", 0.5, "test:1") for r in runs}
+
+    _write_batch(str(out), 5, 10, records(range(5, 10), 1000.0), outputs, 5)
+    assert open_sweep(out, verify=True).load()["x__amplitude"].values[7] == 1007.0
+    shutil.rmtree(out)
+    run_sweep(osc_sweep(OSC_SWEEP.replace("batch_size = 5", "batch_size = 4")), out,
+              client=client, evaluate=ev)
+    before = open_sweep(out).load()
+    assert before.attrs["batch_size"] == 4
+    _write_batch(str(out), 4, 8, records(range(4, 8), 3000.0), outputs, 4)
+    after = open_sweep(out, verify=True).load()
+    for name in ("x__amplitude", "x__wave"):
+        for r in range(12):
+            want = np.full(before[name].shape[1:], 3000.0 + r) if 4 <= r < 8 else \
+                before[name].values[r]
+            np.testing.assert_array_equal(after[name].values[r], want, err_msg=f"{name}[{r}]")
+    assert list(after.warning.values[4:8]) == ["rewritten"] * 4

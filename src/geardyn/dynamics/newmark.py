@@ -786,7 +786,15 @@ def _dataset(case, dyn: DynamicModel, stiffness_map: StiffnessMap, which: str,
     data["transmission_error"] = ("time", te, {
         "units": "rad", "long_name": "transmission error theta_p - (r_b2/r_b1) theta_g "
                                      "(= theta_p - theta_g for equal gears)"})
-    data["mesh_deflection"] = ("time", z @ dyn.g, {
+    # a sum over the six columns, not ``z @ dyn.g``: OpenBLAS threads a matrix-vector product
+    # this long (0.6 ms), and its helper thread then spins on another core for about 0.1 s
+    # (0.10-0.11 s of CPU a run of the sweep benchmark's case, 2026-11-27), taking that core
+    # from the figure process, the kernel's compiler or a second run; the column sum costs
+    # about 1 ms, and rounds the same on every CPU (a BLAS kernel's order depends on it)
+    deflection = z[:, 0] * dyn.g[0]
+    for i in range(1, 6):
+        deflection += z[:, i] * dyn.g[i]
+    data["mesh_deflection"] = ("time", deflection, {
         "units": "m", "long_name": "mesh deflection along the line of action p (eq. 15)"})
     data["mesh_force"] = ("time", rows[:, K.R_N], {
         "units": "N", "long_name": "normal mesh force h N (eq. 14)"})
