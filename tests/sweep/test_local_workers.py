@@ -15,7 +15,11 @@ import pytest
 
 from geardyn.errors import InputError
 from geardyn.studies.sweep import open_sweep, run_sweep
-from geardyn.studies.sweep.local_workers import WORKER_PRELOAD, worker_start_method
+from geardyn.studies.sweep.local_workers import (
+    WORKER_MALLOC,
+    WORKER_PRELOAD,
+    worker_start_method,
+)
 
 from .._cli_fork import run_geardyn
 from ._procs import GEARDYN, env, start, stop
@@ -47,8 +51,8 @@ def _worker_state(cl) -> list[tuple[bool, str]]:
     return list(cl.run(state).values())
 
 
-def _trim_threshold(cl) -> set:
-    return set(cl.run(lambda: os.environ.get("MALLOC_TRIM_THRESHOLD_")).values())
+def _malloc_settings(cl) -> set:
+    return set(cl.run(lambda: tuple(os.environ.get(k) for k in WORKER_MALLOC)).values())
 
 
 @pytest.mark.skipif(not LINUX, reason="the forkserver start is Linux's")
@@ -58,16 +62,18 @@ def test_two_workers_fork_from_the_preloaded_server_one_or_as_asked_spawns(monke
     monkeypatch.delenv("GEARDYN_WORKER_START", raising=False)
     assert worker_start_method(2) == "forkserver" and worker_start_method(8) == "forkserver"
     assert worker_start_method(1) == "spawn"  # one worker: nothing to share
-    monkeypatch.delenv("MALLOC_TRIM_THRESHOLD_", raising=False)
+    for k in WORKER_MALLOC:
+        monkeypatch.delenv(k, raising=False)
     environ = dict(os.environ)
     with _dask_client(None, 2, None) as cl:
         forked = _worker_state(cl)
-        trim = _trim_threshold(cl)
+        malloc = _malloc_settings(cl)
         profiling = cl.run(lambda: __import__("dask").config.get(
             "distributed.worker.profile.enabled"))
     assert forked == [(True, "1"), (True, "1")], forked  # the nanny's variables arrived too
     assert set(profiling.values()) == {False}  # no dashboard: no stack sampling every 10 ms
-    assert trim == {None}  # glibc left to keep a run's freed memory for the next run
+    # glibc keeps a run's freed arrays (up to 32 MB each) for the next run, not Dask's 64 kB
+    assert malloc == {(str(32 * 2 ** 20), str(64 * 2 ** 20))}, malloc
     assert dict(os.environ) == environ
     monkeypatch.setenv("GEARDYN_WORKER_START", "spawn")  # (the slow test spawns two workers)
     assert worker_start_method(2) == "spawn"

@@ -26,8 +26,14 @@ system at once and fixes its thresholds: every array of a run's record is then m
 faulted in afresh. A run of the sweep benchmark's case (model II, 1.5 s simulated, with its
 diagnostics) took 0.088-0.089 s in such a worker against 0.067 s without the variable, in the
 same process tree (2026-11-27, two alternating pairs; the bare loop in the first process
-0.060 s). geardyn's local cluster leaves the variable unset (a value the user has set is kept:
-Dask lets the environment win); a worker then keeps up to one run's freed memory for the next.
+0.060 s). Left to itself, glibc still mapped a run's largest arrays afresh (16-32 MB: a
+worker's run took 0.075-0.083 s). geardyn's local cluster sets
+:data:`WORKER_MALLOC`: glibc's mmap threshold at 32 MB and its trim threshold at 64 MB, the
+values its own adaptive threshold stops at on 64-bit systems, from the start: 0.061-0.064 s a
+run, for 10 MB more peak memory (a worker's ``VmHWM``: 384 MB against 374 MB; 16 MB / 32 MB
+gave no gain; 64 MB / 128 MB the same as 32 MB / 64 MB; measured 2026-11-27, three sweeps of
+the benchmark's 64 runs each). A value the user has set is kept (Dask lets the environment
+win); other C libraries ignore the variables.
 
 Measured on 2026-11-27 (AMD EPYC, 2 cores, ``geardyn sweep
 examples/faults/sweep_spall_width.toml``: four runs on two workers, fresh geardyn cache, numba's
@@ -43,10 +49,13 @@ import sys
 from collections.abc import Iterator
 from contextlib import contextmanager
 
-__all__ = ["WORKER_PRELOAD", "worker_start_method", "local_worker_settings"]
+__all__ = ["WORKER_PRELOAD", "WORKER_MALLOC", "worker_start_method", "local_worker_settings"]
 
 #: What the forkserver imports before it forks a worker (module names, imported in this order).
 WORKER_PRELOAD = ("distributed", "geardyn.studies.sweep._worker_preload")
+
+#: glibc's allocator settings for the workers [bytes] (read when a process starts; see above).
+WORKER_MALLOC = {"MALLOC_MMAP_THRESHOLD_": 32 * 1024 ** 2, "MALLOC_TRIM_THRESHOLD_": 64 * 1024 ** 2}
 
 _METHODS = ("forkserver", "spawn")
 
@@ -93,9 +102,9 @@ def local_worker_settings(n_workers: int) -> Iterator[str]:
     from distributed.utils import get_mp_context
 
     method = worker_start_method(n_workers)
+    malloc = {f"distributed.nanny.pre-spawn-environ.{k}": v for k, v in WORKER_MALLOC.items()}
     with dask.config.set({"distributed.worker.multiprocessing-method": method,
-                          "distributed.worker.profile.enabled": False,
-                          "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}):
+                          "distributed.worker.profile.enabled": False, **malloc}):
         if method == "forkserver":
             get_mp_context()  # Dask's preload first, then geardyn's
             multiprocessing.get_context("forkserver").set_forkserver_preload(
