@@ -314,9 +314,10 @@ def _write_in_order(out: str, together: Sequence[tuple[str, slice, np.ndarray]],
     One event loop does it through zarr's asynchronous API (``zarr.api.asynchronous.open_group``,
     ``AsyncGroup.getitem``, ``AsyncArray.setitem``), so every chunk of ``together`` is encoded
     and written concurrently. zarr's synchronous API makes one round trip to its I/O thread per
-    array: for a 13-run batch of the paper's case (76 arrays) that took 0.092-0.095 s from
-    eight threads, against 0.057-0.060 s here (2026-11-27, AMD EPYC, 2 cores). The opened
-    arrays are kept for the next batch (:func:`_store_arrays`).
+    array: four batches of the sweep benchmark (13 runs of the paper's case, 76 arrays each),
+    replayed in one process, took 0.095-0.132 s a batch from eight threads against
+    0.060-0.065 s here (2026-11-27, AMD EPYC, 2 cores). The opened arrays are kept for the
+    next batch (:func:`_store_arrays`).
     """
     import asyncio
 
