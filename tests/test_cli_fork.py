@@ -45,9 +45,15 @@ def test_environment_and_folder_reach_the_command(tmp_path):
 
 
 def test_a_timeout_kills_the_command(tmp_path):
+    """A command far longer than its timeout (60 s of recorded time, about 8 s of kernel time
+    on two cores with everything cached: the default 1 s record took under 0.3 s in a warm
+    fork server and the timeout never fired) is killed when the timeout expires."""
+    long = ["simulate", "--stiffness", "pem", "--set", "simulation.record_time=60 s",
+            "--out", str(tmp_path / "s.nc")]
     with pytest.raises(subprocess.TimeoutExpired):
-        run_geardyn(["simulate", "--stiffness", "pem", "--out", str(tmp_path / "s.nc")],
-                    timeout=0.3)
+        r = run_geardyn(long, timeout=1.0)
+        pytest.fail(f"finished within 1 s: exit {r.returncode}, {r.stderr[-2000:]}")
+    assert not (tmp_path / "s.nc").exists()  # killed before it wrote its result
     assert run_geardyn(["--version"], timeout=60).returncode == 0  # the server still serves
 
 
