@@ -183,3 +183,26 @@ def pytest_terminal_summary(terminalreporter):
         for family, n in sorted(counts.items()):
             terminalreporter.write_line(f"{family}: {n} generated inputs, each a valid run or a "
                                         "clean error (exit 2, field named, no traceback)")
+
+
+@pytest.fixture(scope="module")
+def client():
+    """An in-process Dask cluster (two worker threads) for the sweep and reliability tests: the
+    same scheduler and task code paths as a process cluster, without the start-up time."""
+    import logging
+
+    import dask
+    from distributed import Client, LocalCluster
+
+    # as geardyn's own local cluster (geardyn.studies.sweep.execute, local_workers): no
+    # stack sampling every 10 ms for a dashboard nobody sees, and the scheduler's HTTP server
+    # on a free port (dashboard_address=None asks for 8787, and Dask warns "Port 8787 is
+    # already in use" when the other test worker's cluster has it)
+    with dask.config.set({"distributed.worker.profile.enabled": False}):
+        cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=False,
+                               dashboard_address="127.0.0.1:0",
+                               scheduler_kwargs={"dashboard": False}, silence_logs=logging.ERROR)
+    cl = Client(cluster)
+    yield cl
+    cl.close()
+    cluster.close()
