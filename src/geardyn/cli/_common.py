@@ -81,10 +81,13 @@ def one_line(text: str, limit: int = MAX_ERROR_CHARS) -> str:
     return text if len(text) <= limit else text[: limit - 26] + " ... (message shortened)"
 
 
-#: Set by the Ctrl-C handler of :func:`handle_errors`. A KeyboardInterrupt raised while numba
-#: compiles is swallowed by llvmlite's ctypes callbacks ("Exception ignored on calling ctypes
-#: callback function"), so the command would run on to the end; the progress callbacks
-#: (:class:`StageProgress`) raise it again at their next tick.
+#: Set by the Ctrl-C handler of :func:`handle_errors`. A KeyboardInterrupt raised inside a
+#: callback that Python cannot raise from is swallowed: llvmlite's ctypes callbacks while numba
+#: compiles ("Exception ignored on calling ctypes callback function"), the garbage collector's
+#: callbacks (distributed's ``GCDiagnosis`` in a sweep's first process: a Ctrl-C that landed
+#: there was lost and the sweep ran to its end, seen 2026-11-27). :func:`_unraisable` delivers
+#: it to the main thread again; the progress callbacks (:class:`StageProgress`) also raise it
+#: at their next tick.
 _INTERRUPT = {"pending": False}
 
 
@@ -95,18 +98,45 @@ def _on_sigint(signum, frame) -> None:
 
 def _unraisable(default):
     """A :data:`sys.unraisablehook` that keeps a Ctrl-C swallowed by a callback (Python would
-    print "Exception ignored ..." and a traceback) as a pending interrupt, and passes every other
+    print "Exception ignored ..." and a traceback) as a pending interrupt and delivers it to
+    the main thread again (:func:`_thread.interrupt_main` from a thread of its own, 1 ms later:
+    raised there at its next check, outside the callback), drops what such a Ctrl-C leaves behind (see
+    :func:`_half_built_llvm_object`, :func:`_dask_gc_timer_cut_short`), and passes every other
     unraisable exception to ``default``."""
 
     def hook(args) -> None:
         if isinstance(args.exc_value, KeyboardInterrupt):
             _INTERRUPT["pending"] = True
+            import _thread
+
+            # from a thread of its own, a moment later: the main thread gets it at its next
+            # check, out of this hook and the callback (called here, or from a thread this
+            # hook waits for, the handler would raise inside the hook)
+            _thread.start_new_thread(_interrupt_main_soon, ())
             return
-        if _half_built_llvm_object(args):
+        if _half_built_llvm_object(args) or _dask_gc_timer_cut_short(args):
             return
         default(args)
 
     return hook
+
+
+def _interrupt_main_soon() -> None:
+    import _thread
+    import time
+
+    time.sleep(0.001)
+    _thread.interrupt_main()
+
+
+def _dask_gc_timer_cut_short(args) -> bool:
+    """Whether an unraisable exception is distributed's garbage-collection timer
+    (``distributed.gc.GCDiagnosis._gc_callback``) asserting that its previous collection
+    ended: a Ctrl-C raised inside that callback cut the previous one short, and every later
+    collection of the process then prints ``AssertionError`` with a traceback."""
+    obj = getattr(args, "object", None)
+    return (isinstance(args.exc_value, AssertionError)
+            and str(getattr(obj, "__module__", "") or "").startswith("distributed.gc"))
 
 
 def _half_built_llvm_object(args) -> bool:
