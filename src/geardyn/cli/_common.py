@@ -87,12 +87,14 @@ def one_line(text: str, limit: int = MAX_ERROR_CHARS) -> str:
 #: callbacks (distributed's ``GCDiagnosis`` in a sweep's first process: a Ctrl-C that landed
 #: there was lost and the sweep ran to its end, seen 2026-11-27). :func:`_unraisable` delivers
 #: it to the main thread again; the progress callbacks (:class:`StageProgress`) also raise it
-#: at their next tick.
-_INTERRUPT = {"pending": False}
+#: at their next tick. ``"redeliver"``: a delivery by :func:`_interrupt_main_soon` is still
+#: due (whoever raises the interrupt first clears it, so it is raised once).
+_INTERRUPT = {"pending": False, "redeliver": False}
 
 
 def _on_sigint(signum, frame) -> None:
     _INTERRUPT["pending"] = True
+    _INTERRUPT["redeliver"] = False
     raise KeyboardInterrupt
 
 
@@ -107,6 +109,7 @@ def _unraisable(default):
     def hook(args) -> None:
         if isinstance(args.exc_value, KeyboardInterrupt):
             _INTERRUPT["pending"] = True
+            _INTERRUPT["redeliver"] = True
             import _thread
 
             # from a thread of its own, a moment later: the main thread gets it at its next
@@ -122,11 +125,17 @@ def _unraisable(default):
 
 
 def _interrupt_main_soon() -> None:
+    """Raise the pending Ctrl-C in the main thread, 1 ms from now, unless it has been raised
+    meanwhile (a progress tick) or the command is over (its handler no longer
+    :func:`_on_sigint`: the interrupt was handled, or this is not a command's process)."""
     import _thread
+    import signal
     import time
 
     time.sleep(0.001)
-    _thread.interrupt_main()
+    if _INTERRUPT["redeliver"] and signal.getsignal(signal.SIGINT) is _on_sigint:
+        _INTERRUPT["redeliver"] = False
+        _thread.interrupt_main()
 
 
 def _dask_gc_timer_cut_short(args) -> bool:
@@ -152,6 +161,7 @@ def _half_built_llvm_object(args) -> bool:
 def raise_pending_interrupt() -> None:
     """Raise KeyboardInterrupt if a Ctrl-C arrived and was swallowed on the way."""
     if _INTERRUPT["pending"]:
+        _INTERRUPT["redeliver"] = False
         raise KeyboardInterrupt
 
 
@@ -193,9 +203,11 @@ def handle_errors(fn: F) -> F:
                               highlight=False, soft_wrap=True)
             raise typer.Exit(2) from None
         except KeyboardInterrupt:
+            _INTERRUPT["redeliver"] = False  # raised: a delivery still due would raise it again
             _say_interrupted()
         except Exception as exc:  # a bug: say so briefly, keep the traceback for GEARDYN_DEBUG
             if _INTERRUPT["pending"]:
+                _INTERRUPT["redeliver"] = False
                 # a Ctrl-C that landed inside an import which was failing anyway comes out as
                 # CPython's "TypeError: expected a message argument" (the ImportError's message
                 # could not be built with the interrupt pending): still the user's Ctrl-C
@@ -214,7 +226,7 @@ def handle_errors(fn: F) -> F:
                 # process ends: the hook that keeps their __del__ quiet stays
                 if not _INTERRUPT["pending"]:
                     sys.unraisablehook = old_hook
-            _INTERRUPT["pending"] = False
+            _INTERRUPT["pending"] = _INTERRUPT["redeliver"] = False
 
     return wrapper  # type: ignore[return-value]
 
