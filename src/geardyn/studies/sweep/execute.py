@@ -265,7 +265,7 @@ def _dask_client(scheduler: str | None, workers: int | None, client) -> Iterator
     # notebook's later subprocesses inherit it)
     environ = dict(os.environ)
     try:
-        with local_worker_settings(n) as method:  # Linux: forked (2+: from a preloaded server)
+        with local_worker_settings(n) as method:  # Linux, 2+ workers: forked, preloaded
             yield from _local_client(n, method)
     finally:
         for key in set(os.environ) - set(environ):
@@ -283,12 +283,11 @@ def _interrupts_deferred(forked: bool) -> Iterator[None]:
     its start (:func:`.local_workers._start_forkserver`), so this process only holds a Ctrl-C
     pressed while the cluster and its client are made (SIGINT blocked in this thread) and gets
     it when the block ends, as a ``KeyboardInterrupt`` with both to close. Spawned workers
-    (``GEARDYN_WORKER_START=spawn``, other systems) inherit the disposition at their start (a
-    blocked signal mask does not reach a spawned interpreter), so SIGINT is ignored in this
-    process meanwhile, and a Ctrl-C pressed then is lost (0.7-1 s of a start here), as it is
-    where threads cannot block signals (and one just after it can make the spawned workers
-    print "Exception ignored in Client.__del__" at their exit: seen at 1.3-1.9 s on
-    2026-11-27, not mended)."""
+    inherit the disposition at their start (a blocked signal mask does not reach a spawned
+    interpreter), so SIGINT is ignored in this process meanwhile, as before, and a Ctrl-C
+    pressed then is lost (0.7 s of a two-worker start here), as it is where threads cannot
+    block signals (and one just after it can make the spawned workers print "Exception ignored
+    in Client.__del__" at their exit: seen at 1.3-1.9 s on 2026-11-27, not mended)."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return

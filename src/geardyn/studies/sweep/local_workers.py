@@ -4,21 +4,15 @@ how they start and what they do besides the runs.
 *How they start.* Dask's nanny starts each worker with ``multiprocessing``'s *spawn* method by
 default: a fresh interpreter per worker, which imports NumPy, SciPy, xarray, pandas, numba, zarr
 and geardyn's run code itself before its first task (2-3 s of CPU a worker on the 2-core test
-machine). On Linux geardyn starts them with the *forkserver* method instead (Dask's setting
-``distributed.worker.multiprocessing-method``): with two workers or more, one server process
+machine). On Linux, with two workers or more, geardyn starts them with the *forkserver* method
+instead (Dask's setting ``distributed.worker.multiprocessing-method``): one server process
 imports those modules once (:mod:`._worker_preload`) and each worker is forked from it, sharing
 the imported pages copy-on-write. The nanny's variables for its workers
 (``OMP_NUM_THREADS=1``, ...) are in the environment before the server starts (Dask sets them
 before it starts the first worker, and the server starts with the first worker), and the worker
 runs the same code, so a sweep stores the same bits either way
-(``tests/sweep/test_local_workers.py``). One worker has nothing to share: its server imports
-Dask only (:func:`worker_preload`), and the worker imports what its tasks need, as a spawned
-one would. It is forked all the same because of Ctrl-C: a worker forked from the server
-inherits the server's ignored SIGINT, so the first process only holds a Ctrl-C back while the
-cluster starts (:func:`geardyn.studies.sweep.execute._interrupts_deferred`); a spawned worker
-inherits only an ignored disposition, so the first process had to ignore SIGINT for the whole
-start, and a Ctrl-C then was lost (about 1 s of every one-worker sweep: the sweep ran to its
-end). ``GEARDYN_WORKER_START=spawn`` keeps Dask's default; spawn is also what other systems get (on
+(``tests/sweep/test_local_workers.py``). One worker is spawned: there is nothing to share.
+``GEARDYN_WORKER_START=spawn`` keeps Dask's default; spawn is also what other systems get (on
 macOS, forking after the system's libraries have started threads is not safe; Windows has no
 fork).
 
@@ -55,11 +49,9 @@ import sys
 from collections.abc import Iterator
 from contextlib import contextmanager
 
-__all__ = ["WORKER_PRELOAD", "WORKER_MALLOC", "worker_preload", "worker_start_method",
-           "local_worker_settings"]
+__all__ = ["WORKER_PRELOAD", "WORKER_MALLOC", "worker_start_method", "local_worker_settings"]
 
-#: What the forkserver of two workers or more imports before it forks a worker (module names,
-#: imported in this order).
+#: What the forkserver imports before it forks a worker (module names, imported in this order).
 WORKER_PRELOAD = ("distributed", "geardyn.studies.sweep._worker_preload")
 
 #: glibc's allocator settings for the workers [bytes] (read when a process starts; see above).
@@ -69,14 +61,15 @@ _METHODS = ("forkserver", "spawn")
 
 
 def worker_start_method(n_workers: int = 2) -> str:
-    """``"forkserver"`` on Linux; ``"spawn"`` on other systems or with
-    ``GEARDYN_WORKER_START=spawn``.
+    """``"forkserver"`` on Linux for two workers or more; ``"spawn"`` for one worker (there is
+    nothing to share, and the server would import, before the worker starts, what a worker of
+    that sweep may not need: 2.3 s against 1.3 s for a small sweep's one worker, measured
+    2026-11-27), on other systems, or with ``GEARDYN_WORKER_START=spawn``.
 
     Parameters
     ----------
     n_workers : int
-        Workers of the local cluster (any number: it decides what the server imports, see
-        :func:`worker_preload`).
+        Workers of the local cluster.
 
     Raises
     ------
@@ -88,18 +81,9 @@ def worker_start_method(n_workers: int = 2) -> str:
     asked = os.environ.get("GEARDYN_WORKER_START", "").strip().lower()
     if asked and asked not in _METHODS:
         raise InputError("GEARDYN_WORKER_START", asked, " or ".join(_METHODS))
-    if asked == "spawn" or not sys.platform.startswith("linux"):
+    if asked == "spawn" or n_workers < 2 or not sys.platform.startswith("linux"):
         return "spawn"
     return "forkserver"
-
-
-def worker_preload(n_workers: int) -> tuple[str, ...]:
-    """What the forkserver imports before it forks the workers of a local cluster of
-    ``n_workers``: :data:`WORKER_PRELOAD` for two or more (imported once, shared by all), Dask
-    alone for one (nothing to share; the server would import, before the worker starts,
-    what that sweep's worker may not need: 2.3 s against 1.3 s for a small sweep's one
-    worker, measured 2026-11-27)."""
-    return WORKER_PRELOAD if n_workers >= 2 else WORKER_PRELOAD[:1]
 
 
 @contextmanager
@@ -108,10 +92,9 @@ def local_worker_settings(n_workers: int) -> Iterator[str]:
     cluster's lifetime, so that a worker the nanny restarts starts the same way); yields the
     start method (:func:`worker_start_method`).
 
-    With ``"forkserver"``, the server's preload is :func:`worker_preload`, set after Dask's
+    With ``"forkserver"``, the server's preload is :data:`WORKER_PRELOAD`, set after Dask's
     own list (Dask's dependencies, set once per process); a server already running keeps its
-    preload (a library caller's second cluster in the same process: its workers then import
-    what the server has not).
+    preload.
     """
     import multiprocessing
 
@@ -125,7 +108,7 @@ def local_worker_settings(n_workers: int) -> Iterator[str]:
         if method == "forkserver":
             get_mp_context()  # Dask's preload first, then geardyn's
             multiprocessing.get_context("forkserver").set_forkserver_preload(
-                list(worker_preload(n_workers)))
+                list(WORKER_PRELOAD))
             _start_forkserver()
         yield method
 
