@@ -43,7 +43,7 @@ IMPORT_TIME_PREFIXES = ("NUMBA_", "DASK_", "MPL", "MATPLOTLIB", "PYTHON", "OMP_"
 PRELOAD = ("numpy", "scipy.sparse", "scipy.sparse.linalg", "scipy.signal", "scipy.interpolate",
            "scipy.optimize", "scipy.stats", "xarray", "numba", "matplotlib.pyplot", "pydantic",
            "typer", "rich.console", "rich.progress", "skfem", "zarr", "dask", "dask.array",
-           "h5netcdf",
+           "netCDF4", "h5netcdf",
            # imported by geardyn.units, and by xarray (its duck-array check); and
            # dask.distributed, which xarray imports on every to_netcdf where dask is installed
            # (its scheduler check): 0.3-0.5 s of each command that writes or converts units
@@ -103,6 +103,17 @@ def _read_line(fd: int, deadline: float | None) -> dict | None:
     return json.loads(line)
 
 
+def _netcdf4_plugins() -> str | None:
+    """The folder netCDF4 puts in ``HDF5_PLUGIN_PATH`` when it is imported (where unset), in the
+    server and in this process alike once a test imports it; None without netCDF4."""
+    import importlib.util
+
+    spec = importlib.util.find_spec("netCDF4")
+    if spec is None or spec.origin is None:
+        return None
+    return os.path.join(os.path.dirname(spec.origin), "plugins")
+
+
 def _forkable(env: dict[str, str]) -> bool:
     if os.environ.get("GEARDYN_CLI_FORK", "1") == "0" or sys.platform == "win32":
         return False
@@ -110,6 +121,9 @@ def _forkable(env: dict[str, str]) -> bool:
     for key in set(env) | set(base):
         if key == "PYTHONPATH":  # the child puts its entries on sys.path (_child)
             continue
+        if key == "HDF5_PLUGIN_PATH" and {env.get(key), base.get(key)} <= {None,
+                                                                            _netcdf4_plugins()}:
+            continue  # set by netCDF4's import itself, not by the test
         if key.startswith(IMPORT_TIME_PREFIXES) and env.get(key) != base.get(key):
             return False
     return True

@@ -63,6 +63,7 @@ def test_import_time_variables_fall_back_to_a_subprocess():
     assert not _forkable({**os.environ, "NUMBA_DISABLE_JIT": "1"})
     assert not _forkable({**os.environ, "PYTHONHASHSEED": "1"})
     assert _forkable({**os.environ, "PYTHONPATH": "/somewhere", "GEARDYN_PROGRESS": "1"})
+    assert not _forkable({**os.environ, "HDF5_PLUGIN_PATH": "/my/plugins"})
 
 
 @pytest.mark.slow

@@ -18,8 +18,8 @@ __all__ = ["__version__", "package_versions", "PROVENANCE_PACKAGES"]
 __version__ = "0.1.0"
 
 #: The packages whose versions a result records (those that can change a number or a file).
-PROVENANCE_PACKAGES = ("numpy", "scipy", "numba", "xarray", "h5netcdf", "h5py", "matplotlib",
-                       "pydantic", "scikit-fem", "gmsh")
+PROVENANCE_PACKAGES = ("numpy", "scipy", "numba", "xarray", "netCDF4", "h5netcdf", "h5py",
+                       "matplotlib", "pydantic", "scikit-fem", "gmsh")
 
 
 def package_versions(packages: tuple[str, ...] = PROVENANCE_PACKAGES) -> list[tuple[str, str]]:

@@ -465,11 +465,18 @@ def _read_netcdf_table(p: Path) -> DataTable:
     """A NetCDF file as measured data: every 1-D numeric variable (coordinates included, e.g.
     ``time``) is a channel; numeric global attributes (e.g. ``fs``) are scalars, text ones
     (e.g. ``case_toml``) text."""
-    try:
-        import xarray as xr
+    from ..io import NETCDF_LOCK
 
-        ds = xr.open_dataset(p, engine="h5netcdf")
-    except Exception as exc:  # h5netcdf/h5py raise OSError, ValueError, KeyError...
+    with NETCDF_LOCK:  # from the file's opening to its closing
+        return _netcdf_table(p)
+
+
+def _netcdf_table(p: Path) -> DataTable:
+    try:
+        from ..io import open_netcdf
+
+        ds = open_netcdf(p)
+    except Exception as exc:  # netCDF4, h5netcdf and h5py raise OSError, ValueError, KeyError...
         raise DataFileError(p, f"not a readable NetCDF4/HDF5 file ({type(exc).__name__}: "
                                f"{exc})") from exc
     cols: dict[str, np.ndarray] = {}
@@ -497,7 +504,8 @@ def _read_netcdf_table(p: Path) -> DataTable:
 # --------------------------------------------------------------------------------------------
 def read_simulation(path, variables, *,
                     field_name: str = "signals") -> tuple[np.ndarray, dict[str, np.ndarray], dict]:
-    """Read a geardyn simulation result (NetCDF4/HDF5 written by xarray with h5netcdf).
+    """Read a geardyn simulation result (NetCDF-4/HDF5 written by xarray,
+    :func:`geardyn.io.netcdf_engine`).
 
     Parameters
     ----------
@@ -526,14 +534,27 @@ def read_simulation(path, variables, *,
     InputError
         A requested variable is absent (the message lists the data variables present).
     """
-    p = _check_path(path)
-    try:
-        import xarray as xr
+    from ..io import NETCDF_LOCK
 
-        ds = xr.open_dataset(p, engine="h5netcdf")
+    p = _check_path(path)
+    with NETCDF_LOCK:  # from the file's opening to its closing
+        time, data, attrs = _simulation(p, variables, field_name)
+    for v, arr in data.items():
+        if arr.shape != time.shape:
+            raise DataFileError(p, f"variable {v!r} has shape {arr.shape}, not the time "
+                                   f"axis {time.shape}")
+    return time, data, attrs
+
+
+def _simulation(p: Path, variables, field_name: str):
+    try:
+        from ..io import open_netcdf
+
+        ds = open_netcdf(p)
     except ImportError as exc:
-        raise DataFileError(p, f"reading NetCDF needs xarray and h5netcdf ({exc})") from exc
-    except Exception as exc:  # h5netcdf/h5py raise OSError, ValueError, KeyError...
+        raise DataFileError(p, f"reading NetCDF needs xarray and netCDF4 or h5netcdf ({exc})"
+                            ) from exc
+    except Exception as exc:  # netCDF4, h5netcdf and h5py raise OSError, ValueError, KeyError...
         raise DataFileError(p, f"not a readable NetCDF4/HDF5 file ({type(exc).__name__}: "
                                f"{exc})") from exc
     try:
@@ -560,8 +581,4 @@ def read_simulation(path, variables, *,
         attrs["units"] = {v: str(ds[v].attrs.get("units", "")) for v in variables}
     finally:
         ds.close()
-    for v, arr in data.items():
-        if arr.shape != time.shape:
-            raise DataFileError(p, f"variable {v!r} has shape {arr.shape}, not the time "
-                                   f"axis {time.shape}")
     return time, data, attrs

@@ -83,7 +83,7 @@ def load_simulation(path, *, signals: Sequence[str] | None = None,
     Parameters
     ----------
     path : str or path-like
-        The ``.nc`` file (written with ``engine="h5netcdf"``).
+        The ``.nc`` file (NetCDF-4, as ``geardyn simulate`` writes it).
     signals : sequence of str, optional
         Data variables to diagnose; default :data:`SIMULATION_SIGNALS`.
     angle : str

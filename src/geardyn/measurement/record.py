@@ -8,7 +8,7 @@ Layout (the same in the three formats, so each reads like measured data):
 * ``fs`` [Hz], the sample rate (a global attribute in NetCDF, a scalar variable in ``.mat``, a
   ``# fs = ... Hz`` comment line in CSV).
 
-NetCDF-4 (h5netcdf) carries ``units`` and ``long_name`` on every variable and the provenance in
+NetCDF-4 carries ``units`` and ``long_name`` on every variable and the provenance in
 global attributes (case TOML, seeds, chain settings, geardyn version). CSV has a ``#`` comment
 header with the same provenance in short and a header row of column names; ``.mat`` (v5) has one
 column vector per channel, ``fs``, and structs ``units`` and ``attrs``.

@@ -110,6 +110,7 @@ def build_map(case, *, method: str | None = None, cracked: bool = True,
     from ..cache import cache_key, default_cache
     from ..config import Case
     from ..errors import InputError
+    from ..io import to_netcdf
 
     if not isinstance(case, Case):
         raise InputError("case", case, "a geardyn.config.Case (geardyn.load_case(path) or "
@@ -140,8 +141,7 @@ def build_map(case, *, method: str | None = None, cracked: bool = True,
 
     try:
         m, _ = cache.get_or_build("stiffness", key, ".nc", build,
-                                  save=lambda obj, path: obj.to_dataset().to_netcdf(
-                                      path, engine="h5netcdf"),
+                                  save=lambda obj, path: to_netcdf(obj.to_dataset(), path),
                                   load=lambda path: load_cached_map(path, key))
     except GeometryError as exc:
         if exc.field != "centre_distance_change" or exc.value is None:

@@ -453,20 +453,21 @@ def run_file_name(model: str, state: str) -> str:
 def write_run_netcdf(ds, path: Path) -> None:
     """One simulation record as a compressed NetCDF-4 file (atomic): opens with
     ``xarray.open_dataset`` and is accepted by ``geardyn diagnose``."""
-    from ..io import atomic_path
+    from ..io import atomic_path, to_netcdf
 
     path.parent.mkdir(parents=True, exist_ok=True)
     with atomic_path(path, suffix=".nc") as tmp:
-        ds.to_netcdf(tmp, engine="h5netcdf", encoding=_encoding(ds, RUN_ENCODING_FLOAT32))
+        to_netcdf(ds, tmp, encoding=_encoding(ds, RUN_ENCODING_FLOAT32))
 
 
 def _write_run_file(ds, path: Path) -> None:
     """:func:`write_run_netcdf` through the cache (:func:`.paper_cache.write_output`): a run
     into another folder copies the bytes an earlier run wrote for the same record."""
+    from ..io import to_netcdf
     from .paper_cache import write_output
 
     def write(tmp: Path) -> None:
-        ds.to_netcdf(tmp, engine="h5netcdf", encoding=_encoding(ds, RUN_ENCODING_FLOAT32))
+        to_netcdf(ds, tmp, encoding=_encoding(ds, RUN_ENCODING_FLOAT32))
 
     write_output(path, "run", (ds, list(ds.variables)),
                  {"float32": RUN_ENCODING_FLOAT32, "compression": COMPRESSION}, write)

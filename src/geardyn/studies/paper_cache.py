@@ -14,8 +14,9 @@ functions of their inputs, so they are cached like the figures
   archive of the arrays plus a JSON description of the result's dataclasses, read back with
   ``allow_pickle=False``: the loaded result equals the computed one bit for bit, type for type.
 * :func:`write_output`: an output file (kind ``output``) keyed by a fingerprint of the data it
-  encodes, the writer's settings, geardyn's sources and the versions of NumPy, xarray,
-  h5netcdf, h5py and HDF5; a warm run copies the bytes (:meth:`geardyn.cache.Cache.write_file`).
+  encodes, the writer's settings, geardyn's sources, the versions of NumPy and xarray and the
+  NetCDF engine with its libraries (:func:`geardyn.io.netcdf_versions`); a warm run copies the
+  bytes (:meth:`geardyn.cache.Cache.write_file`).
 
 The entries are ordinary cache entries (checksum and key in a sidecar, checked before use;
 written to a temporary file and renamed; rebuilt when damaged) and honour ``GEARDYN_NO_CACHE``.
@@ -32,6 +33,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..io import netcdf_versions
 from .paper_result import _digest, _source_digest
 
 __all__ = ["fingerprint", "cached_diagnosis", "write_output", "without_distributions",
@@ -57,10 +59,6 @@ def _versions(*modules: str) -> dict[str, str]:
     for name in modules:
         mod = importlib.import_module(name)
         out[name] = str(getattr(mod, "__version__", "?"))
-    if "h5py" in modules:
-        import h5py
-
-        out["hdf5"] = str(h5py.version.hdf5_version)
     return out
 
 
@@ -261,5 +259,5 @@ def write_output(target: Path, what: str, data, settings, write: Callable[[Path]
     if not cache.enabled:  # no fingerprint to compute
         return cache.write_file("output", "", target, write)
     key = fingerprint("output", OUTPUT_CACHE_VERSION, what, data, settings, _source_digest(),
-                      _versions("numpy", "xarray", "h5netcdf", "h5py"))
+                      _versions("numpy", "xarray") | netcdf_versions())
     return cache.write_file("output", key[:32], target, write)

@@ -17,7 +17,7 @@ import numpy as np
 
 from .._version import __version__, package_versions
 from ..config import Case, case_to_toml
-from ..io import atomic_path, json_safe
+from ..io import atomic_path, json_safe, to_netcdf
 from .paper_result import StudyResult
 from .paper_validation import SHAPE_FACTOR, STD_FACTOR
 from .paper_values import (
@@ -473,15 +473,14 @@ def write_results_netcdf(path: Path, result: StudyResult, case: Case) -> None:
     """
     root = _tables_dataset(result, case)
     with atomic_path(path, suffix=".nc") as tmp:
-        root.to_netcdf(tmp, engine="h5netcdf", mode="w", encoding=_compressed(root))
+        to_netcdf(root, tmp, mode="w", encoding=_compressed(root))
         for state, m in result.maps.items():
             ds = m.to_dataset()
-            ds.to_netcdf(tmp, engine="h5netcdf", mode="a", group=f"stiffness/{state}",
-                         encoding=_compressed(ds))
+            to_netcdf(ds, tmp, mode="a", group=f"stiffness/{state}", encoding=_compressed(ds))
         for (model, state), diag in result.diagnoses.items():
             ds = _diagnosis_dataset(diag)
-            ds.to_netcdf(tmp, engine="h5netcdf", mode="a",
-                         group=f"diagnostics/model_{model}_{state}", encoding=_compressed(ds))
+            to_netcdf(ds, tmp, mode="a", group=f"diagnostics/model_{model}_{state}",
+                      encoding=_compressed(ds))
 
 
 def _diagnosis_dataset(diag):

@@ -15,7 +15,7 @@ from __future__ import annotations
 import importlib
 
 MODULES = ("numpy", "scipy.sparse", "scipy.interpolate", "scipy.signal", "pandas", "xarray",
-           "dask.array", "zarr", "h5netcdf", "pint", "filelock", "numba",
+           "dask.array", "zarr", "netCDF4", "h5netcdf", "pint", "filelock", "numba",
            "geardyn.studies.sweep.execute", "geardyn.studies.sweep.evaluate", "geardyn.cache",
            "geardyn.faults", "geardyn.stiffness.pem", "geardyn.stiffness.map",
            "geardyn.dynamics.newmark", "geardyn.dynamics.results",
