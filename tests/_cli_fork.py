@@ -43,7 +43,7 @@ IMPORT_TIME_PREFIXES = ("NUMBA_", "DASK_", "MPL", "MATPLOTLIB", "PYTHON", "OMP_"
 PRELOAD = ("numpy", "scipy.sparse", "scipy.sparse.linalg", "scipy.signal", "scipy.interpolate",
            "scipy.optimize", "scipy.stats", "xarray", "numba", "matplotlib.pyplot", "pydantic",
            "typer", "rich.console", "rich.progress", "skfem", "zarr", "dask", "dask.array",
-           "netCDF4", "h5netcdf",
+           "h5netcdf",
            # imported by geardyn.units, and by xarray (its duck-array check); and
            # dask.distributed, which xarray imports on every to_netcdf where dask is installed
            # (its scheduler check): 0.3-0.5 s of each command that writes or converts units
@@ -276,6 +276,9 @@ def _serve(req_fd: int, rep_fd: int) -> None:
         except ImportError:  # an optional library missing: the child imports what it needs
             pass
     assert not [m for m in sys.modules if m.startswith("geardyn.cli")], "no console before fork"
+    from geardyn.io import netcdf_engine
+
+    netcdf_engine()  # imports netCDF4 where geardyn uses it (not where it clashes with h5py)
     _numba_registries()
     buf = b""
     while True:

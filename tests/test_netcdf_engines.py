@@ -3,7 +3,8 @@
 The two engines must give files either one reads back identically: a run record as
 ``geardyn run`` writes it (compressed, float32 variables), a file with groups as
 ``results.nc`` is, and the files of the CLI's writer. The fallback is exercised with netCDF4's
-import blocked, and a file one engine cannot open is read with the other.
+import blocked and with its HDF5 clashing with h5py's. Tests that write through netCDF4 are
+skipped where the two clash (importing it would break h5py in this process).
 """
 
 from __future__ import annotations
@@ -20,6 +21,13 @@ from geardyn import io
 from geardyn.errors import DataFileError
 
 
+def needs_netcdf4() -> None:
+    """Skip unless netCDF4 is installed and can live beside h5py in this process."""
+    pytest.importorskip("netCDF4")
+    if io.hdf5_libraries_clash():
+        pytest.skip("netCDF4's HDF5 clashes with h5py's here (geardyn uses h5netcdf)")
+
+
 @pytest.fixture
 def engine(monkeypatch):
     """Set the engine geardyn uses (the choice is cached per process: cleared before, after)."""
@@ -31,7 +39,7 @@ def engine(monkeypatch):
             monkeypatch.setitem(sys.modules, "netCDF4", None)  # import netCDF4 -> ImportError
         else:
             monkeypatch.delitem(sys.modules, "netCDF4", raising=False)
-            pytest.importorskip("netCDF4")
+            needs_netcdf4()
         assert io.netcdf_engine() == name
 
     yield use
@@ -75,7 +83,7 @@ def test_without_netcdf4_h5netcdf_writes_and_reads(engine, tmp_path):
 @pytest.mark.parametrize("writer, reader", [("netcdf4", "h5netcdf"), ("h5netcdf", "netcdf4")])
 def test_a_run_file_of_either_engine_reads_the_same_with_the_other(monkeypatch, tmp_path,
                                                                    writer, reader):
-    pytest.importorskip("netCDF4")
+    needs_netcdf4()
     from geardyn.studies.paper import write_run_netcdf
 
     ds = record()
@@ -92,7 +100,7 @@ def test_a_run_file_of_either_engine_reads_the_same_with_the_other(monkeypatch, 
 
 @pytest.mark.parametrize("writer, reader", [("netcdf4", "h5netcdf"), ("h5netcdf", "netcdf4")])
 def test_groups_written_by_either_engine_read_the_same(tmp_path, writer, reader):
-    pytest.importorskip("netCDF4")
+    needs_netcdf4()
     root = xr.Dataset({"table": ("row", np.arange(4.0))}, attrs={"title": "tables"})
     group = record()
     path = tmp_path / "results.nc"
@@ -104,15 +112,62 @@ def test_groups_written_by_either_engine_read_the_same(tmp_path, writer, reader)
         xr.testing.assert_identical(b.load(), group)
 
 
-def test_a_file_the_chosen_engine_cannot_open_is_read_by_the_other(monkeypatch, tmp_path):
+def test_with_clashing_hdf5_libraries_netcdf4_is_not_even_imported(tmp_path):
+    code = textwrap.dedent(f"""
+        import sys
+        import xarray as xr
+        from geardyn import io
+        io.hdf5_libraries_clash = lambda: True
+        ds = xr.Dataset({{"a": ("t", [1.0, 2.0])}}, attrs={{"x": 1}})
+        io.write_netcdf_atomic(ds, {str(tmp_path / "c.nc")!r})
+        assert io.read_netcdf({str(tmp_path / "c.nc")!r}).identical(ds)
+        print(io.netcdf_engine(), "netCDF4" in sys.modules)
+    """)
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr[-2000:]
+    assert r.stdout.split() == ["h5netcdf", "False"]
+
+
+def test_the_clash_is_the_same_hdf5_library_file_in_both_wheels(tmp_path, monkeypatch):
+    # the wheels' layout: <site>/<pkg>/ and <site>/<pkg>.libs/ (auditwheel, delvewheel), or
+    # <site>/<pkg>/.dylibs/ (delocate); file names carry a hash of the library
+    site = tmp_path / "site"
+    for pkg, libs in {"ncpkg": ["libhdf5-7b49ac63.so.310.2.0", "libhdf5_hl-123198ff.so.310.0.2",
+                                "libnetcdf-6ebc343d.so.19", "libsz-b66d1717.so.2.0.1"],
+                      "h5pkg": ["libhdf5-7f639dcd.so.310.2.0", "libhdf5_hl-123198ff.so.310.0.2",
+                                "libsz-b66d1717.so.2.0.1"],
+                      "h5other": ["libhdf5-9e18f0c6.so.320.0.0", "libhdf5_hl-69da89c9.so.320.0.0",
+                                  "libsz-b66d1717.so.2.0.1"],
+                      "macpkg": []}.items():
+        (site / pkg).mkdir(parents=True)
+        (site / pkg / "__init__.py").write_text("")
+        folder = site / f"{pkg}.libs"
+        folder.mkdir()
+        for name in libs:
+            (folder / name).write_text("")
+    (site / "macpkg" / ".dylibs").mkdir()
+    (site / "macpkg" / ".dylibs" / "libhdf5_hl.310.dylib").write_text("")
+    monkeypatch.syspath_prepend(str(site))
+    assert io._bundled_hdf5("ncpkg") == {"libhdf5-7b49ac63.so.310.2.0",
+                                         "libhdf5_hl-123198ff.so.310.0.2"}
+    assert io._bundled_hdf5("h5pkg") & io._bundled_hdf5("ncpkg") == {
+        "libhdf5_hl-123198ff.so.310.0.2"}  # (libsz alone is no clash: no HDF5 state)
+    assert not io._bundled_hdf5("h5other") & io._bundled_hdf5("ncpkg")
+    assert io.hdf5_libraries_clash("ncpkg", "h5pkg")
+    assert not io.hdf5_libraries_clash("ncpkg", "h5other")
+    assert not io.hdf5_libraries_clash("ncpkg", "no_such_package_here")
+    assert io._bundled_hdf5("macpkg") == {"libhdf5_hl.310.dylib"}
+    assert io._bundled_hdf5("no_such_package_here") == set()
+
+
+def test_a_netcdf3_file_is_read_through_netcdf4(tmp_path):
     # NetCDF-3 (classic) has no HDF5 container: netCDF-C reads it, h5netcdf cannot
-    pytest.importorskip("netCDF4")
+    needs_netcdf4()
     ds = record()
     path = tmp_path / "classic.nc"
     ds.to_netcdf(path, engine="netcdf4", format="NETCDF3_64BIT")
     with pytest.raises(OSError):  # h5py: not an HDF5 file
         xr.open_dataset(path, engine="h5netcdf")
-    monkeypatch.setattr(io, "netcdf_engine", lambda: "h5netcdf")  # h5netcdf tried first
     xr.testing.assert_identical(io.read_netcdf(path), ds)
 
 
@@ -125,7 +180,7 @@ def test_a_file_neither_engine_opens_is_a_data_file_error(tmp_path):
 
 def test_a_netcdf3_measurement_is_read_as_data(tmp_path):
     # a DAQ's NetCDF-3 file: read by netCDF-C (h5netcdf alone could not open it)
-    pytest.importorskip("netCDF4")
+    needs_netcdf4()
     from geardyn.diagnostics.io import read_table
 
     t = np.arange(0.0, 0.1, 1e-4)

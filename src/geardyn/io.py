@@ -10,7 +10,8 @@ rename leaves one behind, and the next write of the same destination (or
 gone (same host), or it is older than :data:`STALE_SECONDS` (another host sharing the folder).
 
 NetCDF-4 files are written and read through xarray with :func:`netcdf_engine`: netCDF4-python
-(Unidata's netCDF-C library) where it is installed, h5netcdf (h5py) otherwise. Both write
+(Unidata's netCDF-C library) where it is installed and its HDF5 does not clash with h5py's,
+h5netcdf (h5py) otherwise. Both write
 NetCDF-4 (HDF5) files that either reads; netCDF-C creates and opens variables in C, h5netcdf in
 Python, per variable (see :func:`netcdf_engine` for what that costs).
 """
@@ -193,15 +194,13 @@ def write_json_atomic(path: str | os.PathLike, obj: object) -> None:
 #: closed its file, 2026-11-27); h5py serialises its own calls anyway.
 NETCDF_LOCK = threading.RLock()
 
-#: xarray's NetCDF-4 engines, in the order :func:`netcdf_engine` prefers them, each with the
-#: module it needs.
-NETCDF_ENGINES = (("netcdf4", "netCDF4"), ("h5netcdf", "h5netcdf"))
 
 
 @functools.cache
 def netcdf_engine() -> str:
     """The xarray engine geardyn writes and reads NetCDF-4 files with: ``"netcdf4"`` where
-    netCDF4-python imports, else ``"h5netcdf"`` (a platform without a netCDF4 wheel).
+    netCDF4-python is installed and its HDF5 libraries do not clash with h5py's
+    (:func:`hdf5_libraries_clash`), else ``"h5netcdf"``.
 
     Both give NetCDF-4 (HDF5) files with the same variables, values, attributes and groups,
     which either engine reads (``tests/test_netcdf_engines.py``). netCDF4 is the faster: a
@@ -210,22 +209,62 @@ def netcdf_engine() -> str:
     through h5py in Python (xarray 2026.9.0, netCDF4 1.7.5.1 / netCDF-C 4.10.1, h5netcdf 1.8.2,
     2026-11-27, AMD EPYC, 2 cores). Where zlib dominates, less: a compressed run record of the
     paper's case (24 variables x 50,000 samples) 0.145 s against 0.196 s, read back in 0.028 s
-    against 0.122 s (``benchmarks/run.py netcdf``). The choice is made once per process.
+    against 0.122 s (``benchmarks/run.py netcdf``). The choice is made once per process, and
+    netCDF4 is not imported where it is not chosen.
 
     Returns
     -------
     str
         ``"netcdf4"`` or ``"h5netcdf"``.
     """
-    import importlib
+    import importlib.util
 
-    for engine, module in NETCDF_ENGINES:
+    if importlib.util.find_spec("netCDF4") is not None and not hdf5_libraries_clash():
         try:
-            importlib.import_module(module)
+            import netCDF4  # noqa: F401
         except ImportError:
-            continue
-        return engine
-    return NETCDF_ENGINES[-1][0]  # h5netcdf is a dependency: its own import error says more
+            pass
+        else:
+            return "netcdf4"
+    return "h5netcdf"
+
+
+def _bundled_hdf5(package: str) -> set[str]:
+    """File names of the HDF5 libraries a wheel of ``package`` bundles (``<package>.libs/``
+    beside it on Linux and Windows, ``<package>/.dylibs/`` on macOS), found without importing
+    it; empty where it bundles none (conda shares one HDF5) or is not installed."""
+    import importlib.util
+
+    try:
+        spec = importlib.util.find_spec(package)
+    except (ImportError, ValueError):
+        return set()
+    if spec is None or not spec.submodule_search_locations:
+        return set()
+    names: set[str] = set()
+    for location in spec.submodule_search_locations:
+        pkg = Path(location)
+        for folder in (pkg.parent / f"{pkg.name}.libs", pkg.parent / f"{pkg.name.lower()}.libs",
+                       pkg / ".dylibs"):
+            with contextlib.suppress(OSError):
+                names |= {n for n in os.listdir(folder)
+                          if n.lower().startswith(("libhdf5", "hdf5"))}
+    return names
+
+
+def hdf5_libraries_clash(first: str = "netCDF4", second: str = "h5py") -> bool:
+    """Whether the wheels of ``first`` and ``second`` (netCDF4's and h5py's) bundle an HDF5
+    library under the same file name.
+
+    The name carries a hash of the file, so the same name is the same build, and the dynamic
+    loader loads it once, bound to the HDF5 of whichever package was imported first: then
+    the other's dimension scales fail (``NetCDF: Problem with HDF5 dimscales`` from netCDF4
+    after h5py, ``Unspecified error in H5DSis_scale`` from h5py after netCDF4). Seen with
+    h5py 3.10.0 and netCDF4 1.7.1.post1 (both ``libhdf5_hl-123198ff.so.310.0.2``) and with
+    h5py 3.15.1 and netCDF4 1.7.4; h5py 3.13.0 with netCDF4 1.7.3 (HDF5 1.14.6 in both, other
+    builds) and h5py 3.16.0 with netCDF4 1.7.5.1 work (2026-11-27, Linux x86-64).
+    """
+    return bool(_bundled_hdf5(first) & _bundled_hdf5(second))
 
 
 def netcdf_versions() -> dict[str, str]:
@@ -249,10 +288,9 @@ def netcdf_versions() -> dict[str, str]:
 
 
 def open_netcdf(path: str | os.PathLike, **kwargs):
-    """``xarray.open_dataset(path, engine=netcdf_engine(), **kwargs)``; a file that engine
-    cannot open is tried with the other installed one (e.g. NetCDF-3, which only netCDF4
-    reads), and the first engine's error raised if neither can. Hold :data:`NETCDF_LOCK` from
-    this call until the dataset is closed.
+    """``xarray.open_dataset(path, engine=netcdf_engine(), **kwargs)`` (through netCDF4 it
+    reads NetCDF-3 files too). Hold :data:`NETCDF_LOCK` from this call until the dataset is
+    closed.
 
     Returns
     -------
@@ -261,15 +299,7 @@ def open_netcdf(path: str | os.PathLike, **kwargs):
     """
     import xarray as xr
 
-    first = netcdf_engine()
-    engines = [first] + [e for e, _ in NETCDF_ENGINES if e != first]  # (one not installed fails)
-    error = None
-    for engine in engines:
-        try:
-            return xr.open_dataset(path, engine=engine, **kwargs)
-        except Exception as exc:  # noqa: BLE001 - the libraries raise many types for bad files
-            error = error or exc
-    raise error
+    return xr.open_dataset(path, engine=netcdf_engine(), **kwargs)
 
 
 def to_netcdf(ds, path: str | os.PathLike, **kwargs) -> None:

@@ -15,7 +15,7 @@ from __future__ import annotations
 import importlib
 
 MODULES = ("numpy", "scipy.sparse", "scipy.interpolate", "scipy.signal", "pandas", "xarray",
-           "dask.array", "zarr", "netCDF4", "h5netcdf", "pint", "filelock", "numba",
+           "dask.array", "zarr", "h5netcdf", "pint", "filelock", "numba",
            "geardyn.studies.sweep.execute", "geardyn.studies.sweep.evaluate", "geardyn.cache",
            "geardyn.faults", "geardyn.stiffness.pem", "geardyn.stiffness.map",
            "geardyn.dynamics.newmark", "geardyn.dynamics.results",
@@ -29,6 +29,9 @@ def _preload() -> None:
             importlib.import_module(name)
         except ImportError:  # an optional library missing: the worker imports what it needs
             continue
+    from geardyn.io import netcdf_engine
+
+    netcdf_engine()  # netCDF4 where geardyn uses it (not where its HDF5 clashes with h5py's)
     try:
         from numba.core.registry import cpu_target
 
