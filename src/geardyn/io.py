@@ -11,9 +11,9 @@ gone (same host), or it is older than :data:`STALE_SECONDS` (another host sharin
 
 NetCDF-4 files are written and read through xarray with :func:`netcdf_engine`: netCDF4-python
 (Unidata's netCDF-C library) where it is installed and its HDF5 does not clash with h5py's,
-h5netcdf (h5py) otherwise. Both write
-NetCDF-4 (HDF5) files that either reads; netCDF-C creates and opens variables in C, h5netcdf in
-Python, per variable (see :func:`netcdf_engine` for what that costs).
+h5netcdf (h5py) otherwise. Both write NetCDF-4 (HDF5) files that either reads; netCDF-C creates
+and opens variables in C, h5netcdf in Python, per variable (see :func:`netcdf_engine` for what
+that costs). Every access holds :data:`NETCDF_LOCK`.
 """
 
 from __future__ import annotations
@@ -195,7 +195,6 @@ def write_json_atomic(path: str | os.PathLike, obj: object) -> None:
 NETCDF_LOCK = threading.RLock()
 
 
-
 @functools.cache
 def netcdf_engine() -> str:
     """The xarray engine geardyn writes and reads NetCDF-4 files with: ``"netcdf4"`` where
@@ -219,14 +218,13 @@ def netcdf_engine() -> str:
     """
     import importlib.util
 
-    if importlib.util.find_spec("netCDF4") is not None and not hdf5_libraries_clash():
-        try:
-            import netCDF4  # noqa: F401
-        except ImportError:
-            pass
-        else:
-            return "netcdf4"
-    return "h5netcdf"
+    if importlib.util.find_spec("netCDF4") is None or hdf5_libraries_clash():
+        return "h5netcdf"
+    try:
+        import netCDF4  # noqa: F401
+    except ImportError:  # a broken install (its compiled module missing)
+        return "h5netcdf"
+    return "netcdf4"
 
 
 def _bundled_hdf5(package: str) -> set[str]:

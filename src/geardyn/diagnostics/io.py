@@ -472,6 +472,7 @@ def _read_netcdf_table(p: Path) -> DataTable:
 
 
 def _netcdf_table(p: Path) -> DataTable:
+    """:func:`_read_netcdf_table`'s reading, with :data:`geardyn.io.NETCDF_LOCK` held."""
     try:
         from ..io import open_netcdf
 
@@ -547,6 +548,8 @@ def read_simulation(path, variables, *,
 
 
 def _simulation(p: Path, variables, field_name: str):
+    """:func:`read_simulation`'s reading (time, data, attrs), with
+    :data:`geardyn.io.NETCDF_LOCK` held."""
     try:
         from ..io import open_netcdf
 
