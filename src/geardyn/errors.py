@@ -19,6 +19,18 @@ MAX_ALLOWED_CHARS = 300
 _CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f]+")
 
 
+class _NotGiven:
+    """The value of an option or argument the user left out (``--out: got nothing``)."""
+
+    def __repr__(self) -> str:
+        return "nothing"
+
+
+#: Value of an :class:`InputError` for a required option that was not given (its message reads
+#: ``--out: got nothing; ...``, not Python's ``None``).
+NOT_GIVEN: Any = _NotGiven()
+
+
 def _clip(text: str, limit: int) -> str:
     """One line of at most ``limit`` characters (control characters shown as one space)."""
     text = _CONTROL.sub(" ", text)
@@ -46,6 +58,7 @@ def short_repr(value: Any, limit: int = MAX_VALUE_CHARS) -> str:
 
 
 __all__ = [
+    "NOT_GIVEN",
     "GeardynError",
     "InputError",
     "GeometryError",

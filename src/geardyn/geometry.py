@@ -48,6 +48,7 @@ __all__ = [
     "inv",
     "inv_inverse",
     "centre_distance_from_displacements",
+    "check_static_contact",
 ]
 
 
@@ -813,7 +814,10 @@ def _displacements(value, field_name: str) -> np.ndarray:
 
 
 def static_operating_point(pair: GearPair, torque: float, pinion_bearing_stiffness: float,
-                           gear_bearing_stiffness: float) -> OperatingGeometry:
+                           gear_bearing_stiffness: float, *,
+                           fields: tuple[str, str] = ("pinion_bearing_stiffness",
+                                                      "gear_bearing_stiffness")
+                           ) -> OperatingGeometry:
     r"""Operating geometry under a static torque on rigid teeth and flexible bearings.
 
     The mesh force along the LOA is ``N = T / r_b1``; it pushes the pinion to ``y_p = -N/k_yp``
@@ -827,6 +831,13 @@ def static_operating_point(pair: GearPair, torque: float, pinion_bearing_stiffne
         Input torque on the pinion [N m].
     pinion_bearing_stiffness, gear_bearing_stiffness : float
         Bearing stiffnesses along the LOA [N/m], finite and > 0.
+    fields : (str, str)
+        Their names in an error (:func:`check_static_contact`).
+
+    Raises
+    ------
+    GeometryError
+        If the bearings' deflection leaves the teeth out of contact.
     """
     if not isinstance(pair, GearPair):
         raise InputError("pair", pair, "a geardyn.geometry.GearPair")
@@ -838,7 +849,52 @@ def static_operating_point(pair: GearPair, torque: float, pinion_bearing_stiffne
     n = torque / pair.pinion.base_radius
     d = centre_distance_from_displacements(pair, -n / pinion_bearing_stiffness,
                                            n / gear_bearing_stiffness)
-    return pair.operating(float(d) - pair.design_centre_distance)
+    dd = float(d) - pair.design_centre_distance
+    check_static_contact(pair, dd, n, pinion_bearing_stiffness, gear_bearing_stiffness,
+                         fields=fields)
+    return pair.operating(dd)
+
+
+def check_static_contact(pair: GearPair, centre_distance_change: float, mesh_force: float,
+                         pinion_bearing_stiffness: float, gear_bearing_stiffness: float, *,
+                         fields: tuple[str, str] = ("pinion_bearing_stiffness",
+                                                    "gear_bearing_stiffness")) -> None:
+    """Refuse bearings so soft that the static mesh force pushes the teeth out of contact.
+
+    The static centre distance change of eq. 4 beyond
+    :meth:`GearPair.max_centre_distance_change` leaves a contact ratio below 1 (beyond it the
+    teeth separate): the error names the softer bearing, the change and the limit, instead of
+    a centre distance the user never gave.
+
+    Parameters
+    ----------
+    pair : GearPair
+    centre_distance_change : float
+        Static ``d' - d`` [m] under ``mesh_force``.
+    mesh_force : float
+        Static mesh force along the line of action [N].
+    pinion_bearing_stiffness, gear_bearing_stiffness : float
+        Bearing stiffnesses along the LOA [N/m].
+    fields : (str, str)
+        The names of the two stiffnesses in the error (the case's ``pinion.bearing_stiffness``
+        where a case gave them).
+
+    Raises
+    ------
+    GeometryError
+        If the change exceeds the largest with contact ratio >= 1.
+    """
+    dd_max = pair.max_centre_distance_change()
+    if centre_distance_change <= dd_max:
+        return
+    soft = 0 if pinion_bearing_stiffness <= gear_bearing_stiffness else 1
+    k = (pinion_bearing_stiffness, gear_bearing_stiffness)
+    raise GeometryError(
+        fields[soft], k[soft],
+        f"bearings stiff enough to keep the teeth in contact [N/m]: under the static mesh force "
+        f"{mesh_force:.5g} N, {fields[0]} {k[0]:.4g} N/m and {fields[1]} {k[1]:.4g} N/m move "
+        f"the centres {centre_distance_change * 1e3:.5g} mm apart, beyond the largest change "
+        f"with contact ratio >= 1, {dd_max * 1e3:.4f} mm (stiffer bearings or a lower torque)")
 
 
 def geometry_summary(pair: GearPair, centre_distance_change: float = 0.0) -> dict:

@@ -47,11 +47,13 @@ def check_step_count(sim) -> int:
     except (OverflowError, ZeroDivisionError):
         steps = math.inf
     if not math.isfinite(steps) or steps > limit:
+        # whole numbers, not 3 digits: 1.0005e8 steps against 1e8 read "1e+08" on both sides
+        count = f"{steps:,.0f}" if math.isfinite(steps) and steps < 1e15 else f"{steps:.3g}"
         raise InputError(
             "simulation.settle_time, simulation.record_time, simulation.dt",
-            f"{steps:.3g} time steps ((settle {sim.settle_time:.4g} s + record "
+            f"{count} time steps ((settle {sim.settle_time:.4g} s + record "
             f"{sim.record_time:.4g} s) / dt {sim.dt:.4g} s)",
-            f"at most simulation.max_steps = {limit:.3g} steps; raise simulation.max_steps "
+            f"at most simulation.max_steps = {limit:,.0f} steps; raise simulation.max_steps "
             "(e.g. --set simulation.max_steps=1e9) to run it anyway, or lengthen simulation.dt "
             "or shorten the times")
     return int(round(steps))

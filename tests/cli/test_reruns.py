@@ -95,6 +95,22 @@ def test_run_twice_in_the_default_folder_then_other_inputs_refused(tmp_path):
     assert not line.startswith("error: --out")
     # --force keeps its meaning
     assert "--force" in line
+    # a run stopped by an input only its simulation stage checks (the time step against the
+    # map's mesh stiffness), after the geometry and the maps were written: its folder holds
+    # partial results of refused inputs, and the corrected command replaces them without --force
+    bad = run("run", *RUN, "--set", "simulation.dt=1e-3 s", "--out", "bad", cache=cache,
+              cwd=tmp_path)
+    line = _one_error_line(bad)
+    assert "simulation.dt" in line
+    assert (tmp_path / "bad" / "stiffness_healthy.nc").is_file()  # written before the refusal
+    rec_bad = json.loads((tmp_path / "bad" / "inputs.json").read_text())
+    assert rec_bad["complete"] is False and "simulation.dt" in rec_bad["input_error"]
+    fixed = run("run", *RUN, "--out", "bad", cache=cache, cwd=tmp_path)
+    assert fixed.returncode == 0, fixed.stderr
+    assert "stopped on an input error: replacing its partial results" in fixed.stderr
+    rec_fixed = json.loads((tmp_path / "bad" / "inputs.json").read_text())
+    assert rec_fixed["complete"] is True and "input_error" not in rec_fixed
+    assert rec_fixed["identity"] == rec2["identity"]
 
 
 def test_folder_with_unrecorded_results_is_refused(tmp_path):
@@ -180,3 +196,86 @@ def test_diagnose_defaults_beside_each_input_and_reruns(tmp_path):
                  *opts, cache=cache)
     line = _one_error_line(into_a)
     assert "holds results of different inputs" in line and "the content of FILE" in line
+
+
+def test_only_an_input_error_marks_a_folder_replaceable(tmp_path):
+    """``input_errors_recorded``: an input error marks the record, so that other inputs replace
+    the folder ("retry"); a crash or a Ctrl-C leaves it as it was (the same command continues,
+    other inputs are refused)."""
+    from geardyn.cli._outputs import (
+        OutputInUse,
+        OutputTarget,
+        claim_folder,
+        identity,
+        input_errors_recorded,
+    )
+    from geardyn.config import paper_case
+    from geardyn.errors import InputError
+
+    target = OutputTarget(tmp_path / "out", True)
+    a = identity("run", paper_case(), {"quick": True})
+    b = identity("run", paper_case().with_overrides({"motor.torque": 80.0}), {"quick": True})
+    for exc, marked in ((InputError("simulation.dt", 1e-3, "a smaller step"), True),
+                        (RuntimeError("a crash"), False), (KeyboardInterrupt(), False)):
+        assert claim_folder(target, a, force=True, results=["summary.json"]) in ("new",
+                                                                                "again",
+                                                                                "continue")
+        with pytest.raises(type(exc)), input_errors_recorded(target, a):
+            raise exc
+        record = json.loads((target.path / "inputs.json").read_text())
+        assert ("input_error" in record) is marked, (exc, record)
+        assert claim_folder(target, a, force=False, results=["summary.json"]) == "continue"
+        if marked:
+            assert "simulation.dt" in record["input_error"]
+            with pytest.raises(type(exc)), input_errors_recorded(target, a):
+                raise exc  # the same command fails the same way: still replaceable
+            assert claim_folder(target, b, force=False, results=["summary.json"]) == "retry"
+            # b's run now holds the folder: a's inputs are refused again
+            with pytest.raises(OutputInUse):
+                claim_folder(target, a, force=False, results=["summary.json"])
+            claim_folder(target, a, force=True, results=["summary.json"])
+        else:
+            with pytest.raises(OutputInUse):
+                claim_folder(target, b, force=False, results=["summary.json"])
+
+
+def test_different_faults_are_named_key_by_key():
+    """A list of tables (``faults``) is compared entry by entry and key by key, the fault's type
+    first: the refusal names what differs instead of cutting it out of a long repr (a user
+    audit, 2026-11-27: ``faults [{'type': 'spall',...one, 'law': None}] -> [{'type':
+    'breakag...one, 'law': None}]``)."""
+    from pathlib import Path
+
+    from geardyn.cli._outputs import differences, identity
+    from geardyn.config import load_case
+
+    examples = Path(__file__).resolve().parents[2] / "examples" / "faults"
+    spall = identity("run", load_case(examples / "spall.toml"), {"quick": True})
+    breakage = identity("run", load_case(examples / "breakage.toml"), {"quick": True})
+    diff = [d for d in differences(spall, breakage) if d.startswith("faults")]
+    assert diff[0] == "faults[0].type 'spall' -> 'breakage'", diff
+    assert "faults[0].height (none) -> 0.002" in diff, diff
+    assert not any("..." in d or "{" in d for d in diff), diff
+    # a fault added: its set values, not a repr of a dict
+    no_fault = identity("run", load_case(examples / "spall.toml").with_overrides({"faults": []}),
+                        {"quick": True})
+    (added,) = [d for d in differences(no_fault, spall) if d.startswith("faults")]
+    assert added.startswith("faults[0] (none) -> type = 'spall', gear = 'pinion'"), added
+
+
+def test_a_fault_added_to_the_case_file_is_not_up_to_date(tmp_path):
+    """The same case file edited to add a ``[[faults]]`` table: the earlier record is of other
+    inputs (the identity leaves an empty fault list out, so the key was on one side only and was
+    taken for another geardyn version's field: ``simulate`` said "up to date", 2026-11-27)."""
+    case = tmp_path / "case.toml"
+    base = ('extends = "xue_howard"\n[stiffness]\nmethod = "pem"\ncentre_distances = 6\n'
+            'nodes_per_segment = 8\n[simulation]\nrecord_time = "0.004 s"\n'
+            'settle_time = "0.002 s"\n')
+    case.write_text(base)
+    first = run("simulate", "-c", str(case), "-o", "x.nc", cache=tmp_path / "c", cwd=tmp_path)
+    assert first.returncode == 0, first.stderr
+    case.write_text(base + '[[faults]]\ntype = "spall"\ntooth = 11\nstart = "20 mm"\n'
+                           'length = "3 mm"\nwidth = "6 mm"\ndepth = "0.1 mm"\n')
+    line = _one_error_line(run("simulate", "-c", str(case), "-o", "x.nc", cache=tmp_path / "c",
+                               cwd=tmp_path))
+    assert "holds results of different inputs (faults[0] (none) -> type = 'spall'" in line, line

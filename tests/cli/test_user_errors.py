@@ -90,7 +90,7 @@ def test_out_below_a_file_is_refused_first(tmp_path):
 def test_runs_that_would_not_end_are_refused_first(tmp_path, command, override):
     out = tmp_path / ("s.nc" if command == "simulate" else "r")
     line = _one_error_line(run(command, "--out", str(out), *PEM, *override, tmp_path=tmp_path))
-    assert "time steps" in line and "simulation.max_steps = 1e+08" in line
+    assert "time steps" in line and "simulation.max_steps = 100,000,000 steps" in line
     assert "raise simulation.max_steps" in line
     assert not out.exists() and not (tmp_path / "cache").exists()
 
@@ -109,7 +109,7 @@ def test_library_refuses_before_building_anything(monkeypatch):
 
     monkeypatch.setattr(geardyn.stiffness, "build_map", no_map)
     huge = paper_case({"simulation.settle_time": "1e6 s"})
-    with pytest.raises(InputError, match=r"1e\+11 time steps"):
+    with pytest.raises(InputError, match=r"got .100,000,100,000 time steps"):  # (1e6 + 1) / 1e-5
         simulate(huge)
     raised = paper_case({"simulation.settle_time": "1e6 s", "simulation.max_steps": 1e12,
                          "simulation.decimation": 100000})
@@ -122,3 +122,29 @@ def test_long_error_messages_are_cut_to_one_line(tmp_path):
     bad = "x" * 20000
     line = _one_error_line(run("geometry", "--set", f"pinion.teeth={bad}", tmp_path=tmp_path))
     assert "pinion.teeth" in line
+
+
+def test_a_step_count_just_over_the_limit_is_not_rounded_onto_it():
+    """1,000.5 s at 10 us is 100,050,000 steps, over the 1e8 limit: both numbers whole, so they
+    differ on screen (they read "1e+08" both, a user audit of 2026-11-27)."""
+    from geardyn.config import paper_case
+    from geardyn.errors import InputError
+    from geardyn.run_limits import check_step_count
+
+    sim = paper_case({"simulation.record_time": "1000 s"}).simulation
+    with pytest.raises(InputError) as info:
+        check_step_count(sim)
+    assert "got '100,050,000 time steps" in str(info.value), str(info.value)
+    assert "at most simulation.max_steps = 100,000,000 steps" in str(info.value)
+
+
+@pytest.mark.parametrize(("args", "start"), [
+    (["sweep", "examples/faults/sweep_spall_width.toml"], "error: --out: got nothing; allowed: "),
+    (["sweep"], "error: SWEEP_FILE: got nothing; allowed: "),
+    (["crack-growth", "--quick"], "error: --paris-m: got nothing; allowed: required"),
+])
+def test_a_required_option_left_out_is_named_as_missing(tmp_path, args, start):
+    """Not Python's None ("--out: got None", a user audit of 2026-11-27)."""
+    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    line = _one_error_line(run(*args, tmp_path=tmp_path, cwd=root))
+    assert line.startswith(start), line

@@ -50,6 +50,30 @@ def test_measure_writes_three_formats_and_diagnose_reads_them(tmp_path):
     assert kurt["rec.csv"] == pytest.approx(kurt["rec.nc"], rel=1e-9)
     assert kurt["rec.mat"] == pytest.approx(kurt["rec.nc"], rel=1e-9)
 
+    # the CSV and MATLAB copies are formats, not inputs: the same command without them is up
+    # to date (it was refused as "csv True -> False", a user audit of 2026-11-27), and with
+    # them again, where they were removed, writes them from the record, as the run wrote them
+    import numpy as np
+    from scipy.io import loadmat
+
+    csv, mat = (tmp_path / "rec.csv").read_bytes(), loadmat(tmp_path / "rec.mat")
+    base = ["measure", "--model", "I", "--no-crack", "--out", str(out), *SHORT]
+    again = run(*base, cache=tmp_path / "c")
+    assert again.returncode == 0 and "up to date (same inputs)" in again.stderr, again.stderr
+    (tmp_path / "rec.csv").unlink()
+    (tmp_path / "rec.mat").unlink()
+    nc = out.read_bytes()
+    again = run(*base, "--csv", "--mat", cache=tmp_path / "c")
+    assert again.returncode == 0, again.stderr
+    assert "wrote" in again.stderr and out.read_bytes() == nc  # the record itself untouched
+    assert (tmp_path / "rec.csv").read_bytes() == csv
+    mat2 = loadmat(tmp_path / "rec.mat")
+    for key in ("time", "acc", "acc_g", "tach", "fs"):
+        np.testing.assert_array_equal(mat2[key], mat[key], err_msg=key)
+    for field in mat["attrs"].dtype.names:  # numbers stay numbers when read back from NetCDF
+        a, b = mat["attrs"][0, 0][field], mat2["attrs"][0, 0][field]
+        assert a.dtype == b.dtype and np.array_equal(a, b), field
+
 
 @pytest.mark.parametrize("setting, field", [
     ("measurement.fs=5000", "measurement.fs"),

@@ -11,7 +11,10 @@ effective case, the options that change results, the geardyn version) in the out
 - a folder holding results of *different* inputs is refused, naming what differs, unless
   ``--force``;
 - a folder with results but no record (an older geardyn, files put there by hand) is refused
-  unless ``--force``.
+  unless ``--force``;
+- a folder whose run stopped on an input error (:func:`input_errors_recorded`: a bad time
+  step found at the simulation stage, after the maps were written) holds nothing worth
+  keeping: the corrected command replaces it without ``--force``.
 
 ``geardyn simulate`` writes one file; its identity goes into the file's ``geardyn_inputs``
 attribute instead (see :mod:`geardyn.cli.simulate`).
@@ -19,9 +22,11 @@ attribute instead (see :mod:`geardyn.cli.simulate`).
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import tempfile
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -29,7 +34,8 @@ from typing import Any
 from ..errors import InputError
 
 __all__ = ["OutputTarget", "OutputInUse", "RECORD", "identity", "check_writable", "claim_folder", "begin",
-           "mark_complete", "read_record", "differences", "refuse_different", "resolve",
+           "mark_complete", "input_errors_recorded", "read_record", "differences",
+           "refuse_different", "resolve",
            "recorded_inputs", "claim_file",
            "cache_summary", "say_state", "say_cache"]
 
@@ -149,10 +155,14 @@ def differences(old: dict[str, Any], new: dict[str, Any]) -> list[str]:
     diff = []
     if old.get("case_hash") != new.get("case_hash"):
         a, b = old.get("case") or {}, new.get("case") or {}
-        # keys on one side only are fields another geardyn version added or removed
-        keys = sorted(k for k in set(a) & set(b) if a[k] != b[k])
-        diff += [f"{k} {_short(repr(a.get(k)), 40)} -> {_short(repr(b.get(k)), 40)}"
-                 for k in keys]
+        # a key on one side only: a field another geardyn version added or removed (not a
+        # difference of inputs), or, made by this version, a value left out of the identity
+        # when empty (``faults``: a fault added to a case file was "up to date", 2026-11-27)
+        same_version = old.get("geardyn") == new.get("geardyn")
+        keys = sorted([k for k in set(a) & set(b) if a[k] != b[k]]
+                      + [k for k in set(a) ^ set(b) if same_version or k == "faults"])
+        for k in keys:
+            diff += _value_differences(k, a.get(k), b.get(k))
     oa, ob = old.get("options") or {}, new.get("options") or {}
     diff += [f"{k} {_short(repr(oa.get(k)), 40)} -> {_short(repr(ob.get(k)), 40)}"
              for k in sorted(set(oa) | set(ob)) if oa.get(k) != ob.get(k)]
@@ -161,6 +171,35 @@ def differences(old: dict[str, Any], new: dict[str, Any]) -> list[str]:
         if (fa.get(k) or {}).get("sha256") != (fb.get(k) or {}).get("sha256"):
             diff.append(f"the content of {k} {_short((fb.get(k) or fa.get(k) or {}).get('path', ''), 60)}")
     return diff
+
+
+def _value_differences(key: str, a: Any, b: Any) -> list[str]:
+    """``key old -> new`` for one identity value; a list of tables (``faults``) entry by entry
+    and key by key (``faults[0].type 'spall' -> 'breakage'``), so that what differs is not cut
+    out of a long repr."""
+    if isinstance(a, dict) and isinstance(b, dict):
+        order = sorted(set(a) | set(b), key=lambda k: (k != "type", str(k)))  # a fault's type first
+        return [line for k in order if a.get(k) != b.get(k)
+                for line in _value_differences(f"{key}.{k}", a.get(k), b.get(k))]
+    if isinstance(a, list) and b is None or a is None and isinstance(b, list):
+        a, b = a or [], b or []  # a list of tables left out of the identity when empty
+    if (isinstance(a, list) and isinstance(b, list)
+            and any(isinstance(x, dict) for x in (*a, *b))):
+        out = []
+        for i in range(max(len(a), len(b))):
+            x, y = (a[i] if i < len(a) else None), (b[i] if i < len(b) else None)
+            if x != y:
+                out += _value_differences(f"{key}[{i}]", x, y)
+        return out
+
+    def shown(v: Any) -> str:
+        if v is None:
+            return "(none)"
+        if isinstance(v, dict):  # a table added or removed: its set values
+            return _short(", ".join(f"{k} = {w!r}" for k, w in v.items() if w is not None), 120)
+        return _short(repr(v), 40)
+
+    return [f"{key} {shown(a)} -> {shown(b)}"]
 
 
 def refuse_different(target: OutputTarget, diff: list[str]) -> InputError:
@@ -189,12 +228,13 @@ def recorded_inputs(path: Path) -> dict[str, Any] | None:
 
 
 def claim_file(target: OutputTarget, ident: dict[str, Any], *, force: bool,
-               companions: tuple[Path, ...] = ()) -> bool:
+               companions: tuple[Path, ...] = (), companions_needed: bool = True) -> bool:
     """Whether the NetCDF output ``target`` (written atomically, with its inputs in the
     ``geardyn_inputs`` attribute) already holds the results of ``ident`` with its
     ``companions`` beside it: then there is nothing to compute (True). A file of other inputs,
     or one geardyn did not write, is refused without ``force`` (:class:`OutputInUse`); so is a
-    companion file where the output itself is missing."""
+    companion file where the output itself is missing. With ``companions_needed=False`` the
+    output alone decides (the caller writes missing companions from it)."""
     path = target.path
     if not path.exists():
         present = [c for c in companions if c.exists()]
@@ -212,7 +252,8 @@ def claim_file(target: OutputTarget, ident: dict[str, Any], *, force: bool,
     diff = differences(old, ident)
     if diff and not force:
         raise refuse_different(target, diff)
-    return not diff and not force and all(c.exists() for c in companions)
+    return not diff and not force and (not companions_needed
+                                       or all(c.exists() for c in companions))
 
 def check_writable(target: OutputTarget, *, folder: bool = True) -> None:
     """Refuse, before any work, an output that cannot be written.
@@ -278,7 +319,8 @@ def claim_folder(target: OutputTarget, ident: dict[str, Any], *, force: bool,
     -------
     str
         ``"new"``, ``"continue"`` (same inputs, earlier run interrupted), ``"again"`` (same
-        inputs, earlier run complete) or ``"replace"`` (``--force`` over other results).
+        inputs, earlier run complete), ``"replace"`` (``--force`` over other results) or
+        ``"retry"`` (other inputs over a run that stopped on an input error).
     """
     folder = target.path
     check_writable(target, folder=True)
@@ -289,6 +331,8 @@ def claim_folder(target: OutputTarget, ident: dict[str, Any], *, force: bool,
             state = "again" if old.get("complete") else "continue"
         elif force:
             state = "replace"
+        elif old.get("input_error") and not old.get("complete"):
+            state = "retry"  # its inputs were refused: nothing of value to protect
         else:
             raise refuse_different(target, diff)
     else:
@@ -307,6 +351,26 @@ def claim_folder(target: OutputTarget, ident: dict[str, Any], *, force: bool,
 def begin(target: OutputTarget, ident: dict[str, Any]) -> None:
     """Write the inputs record with ``complete: false`` (before the first result file)."""
     _write_record(target.path, {"identity": ident, "complete": False})
+
+
+@contextlib.contextmanager
+def input_errors_recorded(target: OutputTarget, ident: dict[str, Any]) -> Iterator[None]:
+    """Record in the folder's inputs record that the command stopped on an input error.
+
+    For a command that writes results stage by stage after :func:`claim_folder`: a stage can
+    refuse an input only it checks (``geardyn run``: the time step against the map's mesh
+    stiffness, at the simulation stage). The folder then holds the earlier stages' files of
+    inputs that were refused, and the record says so (``"input_error"``, the message), so that
+    the corrected command replaces them (state ``"retry"``) instead of being refused as
+    different inputs. Any other exception (a crash, Ctrl-C) leaves the record as it was: the
+    same command continues the run.
+    """
+    try:
+        yield
+    except InputError as exc:
+        _write_record(target.path, {"identity": ident, "complete": False,
+                                    "input_error": str(exc)})
+        raise
 
 
 def mark_complete(target: OutputTarget, ident: dict[str, Any], lookups: list[dict] | None = None,
@@ -337,7 +401,9 @@ def say_state(state: str, target: OutputTarget) -> None:
     text = {"continue": f"continuing the interrupted run in {where} (same inputs)",
             "again": f"same inputs as the results in {where}: running again (the cache makes it "
                      "fast)",
-            "replace": f"--force: replacing the earlier results in {where}"}.get(state)
+            "replace": f"--force: replacing the earlier results in {where}",
+            "retry": f"the earlier run into {where} stopped on an input error: replacing its "
+                     f"partial results"}.get(state)
     if text:
         err_console.print(f"[dim]{text}[/dim]", highlight=False, soft_wrap=True)
 

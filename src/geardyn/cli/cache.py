@@ -65,7 +65,8 @@ def clear(
                              "(units s, min, h, d, w).", show_default=False)] = None,
     dry_run: Annotated[bool, typer.Option("--dry-run", help="Say what would be removed; "
                                                             "remove nothing.")] = False,
-    yes: Annotated[bool, typer.Option("--yes", help="Remove without asking.")] = False,
+    yes: Annotated[bool, typer.Option("--yes", help="Remove without asking (required where there is "
+                                                   "no terminal to ask in).")] = False,
 ) -> None:
     """Remove cache entries (all, or of some kinds, or unused for a while). A later run builds
     what it needs again. Entries in use by a running geardyn are left alone."""
@@ -73,7 +74,7 @@ def clear(
 
     from ..cache import Cache
     from ..cache_admin import parse_age, prune
-    from ..errors import InputError
+    from ..errors import NOT_GIVEN, InputError
 
     cache = Cache()
     age = None if older_than is None else parse_age(older_than)
@@ -89,7 +90,7 @@ def clear(
         return
     if not yes:
         if not sys.stdin.isatty():
-            raise InputError("--yes", "not given", f"--yes to remove {what} from "
+            raise InputError("--yes", NOT_GIVEN, f"--yes to remove {what} from "
                              f"{cache.root} (or --dry-run to list them)")
         typer.confirm(f"remove {what} from {cache.root}?", abort=True)
     done = prune(cache, kinds=kinds, older_than=age)

@@ -52,10 +52,10 @@ def parse_paris_c(value: str | None, m: float, field: str = "--paris-c") -> floa
     [m/cycle/(Pa m^0.5)^m]: ``C_SI = C (length unit in m) (K unit in Pa)^-m``. A bare number
     is refused (its unit would be a guess). The power may be written ``^m`` or as the number
     given to ``--paris-m``."""
-    from ..errors import InputError
+    from ..errors import NOT_GIVEN, InputError
 
     if value is None:
-        raise InputError(field, None, "required: " + _C_ALLOWED)
+        raise InputError(field, NOT_GIVEN, "required: " + _C_ALLOWED)
     text = _compact(str(value))
     if len(text) > 100:
         raise InputError(field, value, _C_ALLOWED + " (at most 100 characters)")
@@ -178,7 +178,7 @@ def crack_growth(
     crack_growth.csv and figures."""
     import warnings
 
-    from ..errors import InputError
+    from ..errors import NOT_GIVEN, InputError
     from ..units import to_si
     from ._outputs import (
         begin,
@@ -193,7 +193,7 @@ def crack_growth(
     target = resolve(out, DEFAULT_OUT)
     check_writable(target)
     if paris_m is None:
-        raise InputError("--paris-m", None, "required: the Paris exponent m of the material, "
+        raise InputError("--paris-m", NOT_GIVEN, "required: the Paris exponent m of the material, "
                                             "a number in (0, 20] (geardyn ships no default)")
     if not (math.isfinite(paris_m) and 0 < paris_m <= 20):
         raise InputError("--paris-m", paris_m, "a Paris exponent in (0, 20]")

@@ -89,10 +89,23 @@ def measure(
     companions = tuple([out.with_suffix(".csv")] if csv else []) \
         + tuple([out.with_suffix(".mat")] if mat else [])
     check_measurement(case)  # bad chain settings and sample rate fail before the simulation
-    ident = identity("measure", case, {"crack": crack, "csv": csv, "mat": mat})
-    if claim_file(target, ident, force=force, companions=companions):
-        err_console.print(f"[dim]{out} is up to date (same inputs); --force recomputes it[/dim]",
-                          highlight=False, soft_wrap=True)
+    # the CSV and MATLAB copies are other formats of the same record, not other inputs: a
+    # re-run with fewer of them is up to date, one with more writes them from the record
+    ident = identity("measure", case, {"crack": crack})
+    if claim_file(target, ident, force=force, companions=companions, companions_needed=False):
+        missing = [c for c in companions if not c.exists()]
+        if missing:
+            from ..io import read_netcdf
+
+            record = read_netcdf(out)
+            for c in missing:
+                (write_csv if c.suffix == ".csv" else write_mat)(record, c)
+            err_console.print(f"[dim]{out} is up to date (same inputs); wrote "
+                              f"{', '.join(str(c) for c in missing)} from it[/dim]",
+                              highlight=False, soft_wrap=True)
+        else:
+            err_console.print(f"[dim]{out} is up to date (same inputs); --force recomputes "
+                              f"it[/dim]", highlight=False, soft_wrap=True)
         console.print(f"  diagnose it: geardyn diagnose {out} --signal acc --tach tach",
                       highlight=False, soft_wrap=True)
         return

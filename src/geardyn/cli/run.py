@@ -52,6 +52,7 @@ def run(
         check_writable,
         claim_folder,
         identity,
+        input_errors_recorded,
         mark_complete,
         resolve,
         say_state,
@@ -88,7 +89,8 @@ def run(
     fe_processes()  # a bad GEARDYN_FE_PROCESSES refused before the output folder is claimed
     state = claim_folder(target, ident, force=force, results=RESULTS)
     say_state(state, target)
-    with progress_bar() as bar, record_lookups() as lookups:
+    with (input_errors_recorded(target, ident), progress_bar() as bar,
+          record_lookups() as lookups):
         progress = StageProgress(bar, "run: ", stages=tuple(name for name, _ in STAGES))
         result = run_paper_study(case, target.path, quick=quick, progress=progress)
         progress.close()

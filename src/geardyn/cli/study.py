@@ -50,7 +50,8 @@ def model_ii(
         "--workers", "-w", help="Worker processes of the local Dask cluster (default: the "
                                 "number of CPUs).", show_default=False)] = None,
     method: Annotated[str | None, typer.Option(
-        "--method", help="Stiffness method of the maps: pem (the sweep's default, fast) or fe "
+        "--stiffness", "--method", help="Stiffness method of the maps (--method: its older "
+                                        "name): pem (the sweep's default, fast) or fe "
                          "(one FE map per crack depth: far slower).", show_default=False)] = None,
     config: ConfigOption = None,
     set_: SetOption = None,
@@ -73,7 +74,7 @@ def model_ii(
 
     require_extra("sweep")  # dask, distributed, zarr: a clear error naming the extra
     if method is not None and method not in ("pem", "fe"):
-        raise InputError("--method", method, "'pem' or 'fe'")
+        raise InputError("--stiffness", method, "'pem' or 'fe'")
     if workers is not None and workers < 1:
         raise InputError("--workers", workers, "a positive number of worker processes")
     if quick and sweep_file is not None:

@@ -90,7 +90,8 @@ def sweep(
     sweep_file: Annotated[Path | None, typer.Argument(help="Sweep file (TOML).",
                                                       show_default=False)] = None,
     out: Annotated[Path | None, typer.Option("--out", "-o", help="Zarr store to create or "
-                                                                 "resume (a folder).",
+                                                                 "resume (a folder); required "
+                                                                 "to run a sweep.",
                                              show_default=False)] = None,
     verify_store: Annotated[Path | None, typer.Option(
         "--verify", help="Check the store STORE against its per-batch checksums without "
@@ -109,7 +110,7 @@ def sweep(
     retry_failed: Annotated[bool, typer.Option(
         "--retry-failed", help="Compute runs recorded as failed again.")] = False,
     force: Annotated[bool, typer.Option(
-        "--force", help="Overwrite a store that holds a different sweep.")] = False,
+        "--force", "-f", help="Overwrite a store that holds a different sweep.")] = False,
     evaluator: Annotated[str | None, typer.Option(
         "--evaluator", help="Advanced: module:attribute of a custom Evaluator computing each run "
                             "instead of geardyn's simulation + diagnostics.",
@@ -122,7 +123,7 @@ def sweep(
     of the store failed (their errors are in its 'error' variable) or is still pending, after
     the store and the summary are written; 0 if every run is ok."""
     from .._optional import require_extra
-    from ..errors import InputError
+    from ..errors import NOT_GIVEN, InputError
 
     require_extra("sweep")  # before any work: exit 2 naming pip install 'geardyn[sweep]'
     from ..studies.sweep import load_sweep, open_sweep, run_sweep
@@ -134,9 +135,9 @@ def sweep(
         verify(verify_store)
         return
     if sweep_file is None:
-        raise InputError("SWEEP_FILE", None, "a sweep file (TOML), or --verify STORE")
+        raise InputError("SWEEP_FILE", NOT_GIVEN, "a sweep file (TOML), or --verify STORE")
     if out is None:
-        raise InputError("--out", None, "the Zarr store to create or resume (a folder)")
+        raise InputError("--out", NOT_GIVEN, "the Zarr store to create or resume (a folder)")
     if not out.exists() or out.is_dir():  # an existing file: "not a Zarr store", below
         from ._outputs import OutputTarget, check_writable
 

@@ -418,12 +418,19 @@ def _overrides_dict(overrides: Iterable[str] | Mapping[str, Any] | str) -> dict[
 
 
 def _format_validation_error(exc: ValidationError, data: Mapping[str, Any]) -> InputError:
+    from .models import FieldProblem
+
     errs = exc.errors(include_url=False)
     first = errs[0]
-    loc = ".".join(str(p) for p in first["loc"] if not str(p).startswith("function-"))
+    where = tuple(p for p in first["loc"] if not str(p).startswith("function-"))
     msg = first["msg"]
     if msg.startswith("Value error, "):
         msg = msg[len("Value error, "):]
+    problem = (first.get("ctx") or {}).get("error")
+    if isinstance(problem, FieldProblem):  # a section's validator naming one of its fields
+        where = (*where, problem.field)
+        first = {**first, "loc": where, "input": _raw_value(data, where, None)}
+    loc = ".".join(str(p) for p in where)
     if first["type"] == "extra_forbidden":
         parent = ".".join(str(p) for p in first["loc"][:-1])
         allowed = _allowed_keys(parent)
@@ -431,10 +438,39 @@ def _format_validation_error(exc: ValidationError, data: Mapping[str, Any]) -> I
               f"{', '.join(allowed)}"
     elif first["type"] == "missing":
         msg = "a value (this required field is missing)"
+    elif first["type"] in _NUMBER_ERRORS and isinstance(first.get("input"), str):
+        # "20 dB", "7 %": a plain-number field says what its number is, not pydantic's words
+        about = _field_description(where)
+        msg = "a plain number, without a unit" + (f" ({about})" if about else "")
+    elif msg.startswith("Input should be "):  # "Input should be 'pinion' or 'gear'"
+        msg = msg[len("Input should be "):]
     value = _raw_value(data, first["loc"], first.get("input", None))
     more = f" (and {len(errs) - 1} more problem{'s' if len(errs) > 2 else ''})" if len(errs) > 1 \
         else ""
     return InputError(loc or "case", value, msg + more)
+
+
+#: pydantic error types of a value that is not a number.
+_NUMBER_ERRORS = ("float_parsing", "int_parsing", "float_type", "int_type")
+
+
+def _field_description(loc: tuple) -> str:
+    """The description of the case field at ``loc`` (its unit, its meaning), or ''."""
+    model: type[BaseModel] = Case
+    info = None
+    for p in loc:
+        if isinstance(p, int) or str(p).isdigit():  # an entry of a list of tables
+            continue
+        if model is None:
+            return ""
+        info = model.model_fields.get(str(p))
+        if info is None:
+            return ""
+        ann = info.annotation
+        sub = [a for a in getattr(ann, "__args__", (ann,)) if isinstance(a, type)
+               and issubclass(a, BaseModel)]
+        model = sub[0] if sub else None
+    return (info.description or "").rstrip(".") if info is not None else ""
 
 
 def _raw_value(data: Mapping[str, Any], loc: tuple, default: Any) -> Any:

@@ -36,6 +36,24 @@ class _QuantityJsonSchema(WithJsonSchema):
         return copy.deepcopy(super().__get_pydantic_json_schema__(core_schema, handler))
 
 
+class FieldProblem(ValueError):
+    """A model validator's refusal of one field of its section (``field``, relative to it):
+    the user's error then names that field and its value as written, not the whole section
+    (:func:`geardyn.config.loading._format_validation_error`).
+
+    Parameters
+    ----------
+    field : str
+        The field's name in the section (``"centre_distance_max"``).
+    allowed : str
+        What is allowed.
+    """
+
+    def __init__(self, field: str, allowed: str):
+        super().__init__(allowed)
+        self.field = field
+
+
 def _quantity(dimension: str):
     dim = DIMENSIONS[dimension]
 
@@ -172,7 +190,8 @@ class MotorConfig(_Model):
         if self.law == "induction":
             for name in ("synchronous_speed", "breakdown_torque", "breakdown_slip"):
                 if getattr(self, name) is None:
-                    raise ValueError(f"motor.{name} is required with motor.law = 'induction'")
+                    raise FieldProblem(name, f"a value: motor.{name} is required with "
+                                             f"motor.law = 'induction'")
         return self
 
 
@@ -198,10 +217,10 @@ class LoadConfig(_Model):
         if self.law == "table":
             sp, tq = self.table_speeds, self.table_torques
             if not sp or not tq or len(sp) != len(tq) or len(sp) < 2:
-                raise ValueError("load.table_speeds and load.table_torques must be given with "
-                                 "the same length >= 2 for load.law = 'table'")
+                raise FieldProblem("table_speeds", "load.table_speeds and load.table_torques "
+                                   "given with the same length >= 2 for load.law = 'table'")
             if any(b <= a for a, b in zip(sp, sp[1:], strict=False)):
-                raise ValueError("load.table_speeds must be strictly increasing")
+                raise FieldProblem("table_speeds", "strictly increasing speeds")
         elif self.speed is None and self.coefficient is None:
             raise ValueError("give load.speed (to calibrate) or load.coefficient")
         return self
@@ -320,8 +339,8 @@ class FEConfig(_Model):
         if t is not None and (len(t) < 2 or any(b <= a for a, b in zip(t[:-1], t[1:],
                                                                          strict=True))
                               or any(not v > 0 for v in t)):
-            raise ValueError(f"stiffness.fe.torques = {t}: give at least two increasing "
-                             "torques > 0 [N m], or omit it for one map")
+            raise FieldProblem("torques", "at least two increasing torques > 0 [N m], or no "
+                                          "stiffness.fe.torques for one map")
         return self
 
 
@@ -332,7 +351,10 @@ class StiffnessConfig(_Model):
     centre_distance_min: Length = Field(-0.5e-3, description="Lowest centre distance change [m].")
     centre_distance_max: Length = Field(2.0e-3, description="Highest centre distance change [m].")
     centre_distances: int = Field(31, ge=1, le=1001, strict=True,
-                                  description="Number of centre distances in the map.")
+                                  description="Number of centre distances in the map, evenly "
+                                              "spaced over [centre_distance_min, "
+                                              "centre_distance_max]; 1 only where the two are "
+                                              "equal.")
     nodes_per_segment: int = Field(24, ge=2, le=4096, strict=True,
                                    description="Map nodes in each single/double contact zone.")
     body_torsion: bool = Field(False, description="PEM: add each gear body's elastic torsion "
@@ -347,10 +369,22 @@ class StiffnessConfig(_Model):
 
     @model_validator(mode="after")
     def _range(self) -> StiffnessConfig:
-        if self.centre_distance_max < self.centre_distance_min:
-            raise ValueError("stiffness.centre_distance_max must be >= centre_distance_min")
-        if self.centre_distances > 1 and self.centre_distance_max == self.centre_distance_min:
-            raise ValueError("stiffness.centre_distances > 1 needs a non-empty range")
+        lo, hi = self.centre_distance_min, self.centre_distance_max
+        if hi < lo:
+            raise FieldProblem("centre_distance_max", f"a change >= stiffness.centre_distance_min "
+                                                      f"({lo * 1e3:.6g} mm)")
+        if self.centre_distances > 1 and hi == lo:
+            raise FieldProblem("centre_distances", f"1 for the single centre distance change "
+                                                   f"{lo * 1e3:.6g} mm (centre_distance_min = "
+                                                   f"centre_distance_max), or a range with "
+                                                   f"centre_distance_max > centre_distance_min")
+        if self.centre_distances == 1 and hi != lo:
+            # one centre distance is the range's lower end (numpy.linspace): the map would
+            # hold the mesh stiffness there only, whatever the operating centre distance
+            raise FieldProblem("centre_distances", f"at least 2 over the range [{lo * 1e3:.6g}, "
+                                                   f"{hi * 1e3:.6g}] mm, or 1 with "
+                                                   f"centre_distance_min = centre_distance_max "
+                                                   f"(a map at that one centre distance)")
         return self
 
 

@@ -53,7 +53,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError
-from ..geometry import GearPair
+from ..geometry import GearPair, check_static_contact
 
 __all__ = [
     "TorqueLaw",
@@ -526,7 +526,9 @@ def static_equilibrium(model: DynamicModel, stiffness_map, *, which: str = "II",
     ------
     InputError
         If ``which`` is not one of :data:`MODELS`, the mesh is not loaded (``N <= 0``) or the
-        map does not cover the centre distance.
+        map does not cover the centre distance; for models I-static and II also (a
+        ``GeometryError`` naming the softer bearing) if the bearings' static deflection leaves
+        the teeth out of contact (:func:`geardyn.geometry.check_static_contact`).
     """
     if which not in MODELS:
         raise InputError("model", which, ", ".join(repr(m) for m in MODELS))
@@ -540,6 +542,9 @@ def static_equilibrium(model: DynamicModel, stiffness_map, *, which: str = "II",
     yp, yg = -n / kyp, n / kyg
     dd = _static_dd(model.pair, n, kyp, kyg)
     dd_eval = 0.0 if which == "I" else dd
+    if which != "I":  # model I reads the map at the design centre distance whatever dd is
+        check_static_contact(model.pair, dd, n, kyp, kyg,
+                             fields=("pinion.bearing_stiffness", "gear.bearing_stiffness"))
     if not stiffness_map.covers(dd_eval):
         raise InputError("stiffness.centre_distance_max" if dd_eval > stiffness_map.dd[-1]
                          else "stiffness.centre_distance_min",

@@ -110,7 +110,9 @@ def write_mat(ds, path: str | os.PathLike) -> None:
                               for n in ("time", "acc", "acc_g", "tach")}
     out["fs"] = float(ds.attrs["fs"])
     out["units"] = {n: str(ds[n].attrs.get("units", "")) for n in ("time", "acc", "acc_g", "tach")}
+    # NumPy scalars (a record read back from its NetCDF file) as the numbers they hold
+    attrs = {k: (v.item() if isinstance(v, np.generic) else v) for k, v in ds.attrs.items()}
     out["attrs"] = {k: (v if isinstance(v, str | int | float) else str(v))
-                    for k, v in ds.attrs.items()}
+                    for k, v in attrs.items()}
     with atomic_path(Path(path), suffix=".mat") as tmp, open(tmp, "wb") as fh:
         savemat(fh, out, do_compression=True, oned_as="column", long_field_names=True)

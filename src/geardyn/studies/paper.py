@@ -67,7 +67,8 @@ def geometry_stage(case: Case, out: Path, result: StudyResult) -> None:
     """Geometry at the design, +0.5 mm, +1.0 mm and static operating centre distances."""
     pair = case.gear_pair()
     static = static_operating_point(pair, case.motor.torque, case.pinion.bearing_stiffness,
-                                    case.gear.bearing_stiffness)
+                                    case.gear.bearing_stiffness,
+                                    fields=("pinion.bearing_stiffness", "gear.bearing_stiffness"))
     report = {
         "design": geometry_summary(pair, 0.0),
         "dd_0.5mm": geometry_summary(pair, 0.5e-3),
@@ -868,6 +869,33 @@ def _validate(result: StudyResult) -> None:
     result.summary.update(validation_tables(result.summary, paper_case=result.paper_case))
 
 
+def _quick_settings(case: Case, quick: bool) -> tuple[Case, list[dict]]:
+    """The case a run simulates and maps with, and the settings ``--quick`` changed in it.
+
+    Parameters
+    ----------
+    case : Case
+        The user's case (as ``case.toml`` holds it).
+    quick : bool
+        Whether the run is a ``--quick`` one.
+
+    Returns
+    -------
+    used : Case
+        ``case`` with the shorter records of :func:`_simulation_case` and the coarser maps of
+        :func:`quick_map_case`; ``case`` itself without ``--quick``.
+    changed : list of dict
+        ``{"key", "case", "used"}`` (SI values) for every setting ``--quick`` changed, e.g.
+        ``simulation.record_time`` 1.0 s -> 0.3 s; empty without ``--quick`` or where the case
+        is already that short and coarse.
+    """
+    used = _simulation_case(_map_case(case, quick), quick)
+    if used is case:
+        return case, []
+    _, numerical = case_differences(used, reference=case)  # resolutions only: NUMERICAL_KEYS
+    return used, [{"key": d["key"], "case": d["paper"], "used": d["case"]} for d in numerical]
+
+
 def run_paper_study(case: Case | None = None, out: str | Path = "geardyn-out", *,
                     quick: bool = False, stiffness: str | None = None,
                     progress: Progress | None = None) -> StudyResult:
@@ -884,7 +912,10 @@ def run_paper_study(case: Case | None = None, out: str | Path = "geardyn-out", *
     out : path-like
         Output folder (created).
     quick : bool
-        Shorter simulations and coarser maps, for a fast look.
+        Shorter simulations and coarser maps, for a fast look; the summary lists the settings
+        it changed (``quick_settings``) and counts them among the ``numerical_differences``
+        (marked ``without_quick``), never among the physical ones: ``case.toml`` stays the
+        case as given.
     stiffness : {"fe", "pem"}, optional
         Stiffness method; default the case's.
     progress : callable, optional
@@ -899,14 +930,22 @@ def run_paper_study(case: Case | None = None, out: str | Path = "geardyn-out", *
         case = case.with_overrides({"stiffness.method": stiffness})
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    inputs, numerical = case_differences(case)
+    # the paper-case flag from the case's physical inputs; the numerical settings as the run
+    # uses them (with --quick: the shorter records and coarser maps, marked "without_quick")
+    inputs, _ = case_differences(case)
+    used, quick_changed = _quick_settings(case, quick)
+    _, numerical = case_differences(used)
+    without_quick = {d["key"]: d["case"] for d in quick_changed}
+    for d in numerical:
+        if d["key"] in without_quick:
+            d["without_quick"] = without_quick[d["key"]]
     result = StudyResult(out=out, progress=progress, quick=quick, paper_case=not inputs,
                          differences=inputs)
     result.figures = FigureStore(_figure_process(result))
     result.summary.update({"case": case.name, "quick": quick,
                            "stiffness_method": case.stiffness.method, "complete": False,
                            "paper_case": not inputs, "differences_from_paper": inputs,
-                           "numerical_differences": numerical})
+                           "numerical_differences": numerical, "quick_settings": quick_changed})
     if case.load.law == "linear" and case.load.speed:
         result.summary["calibrated_speed_rad_s"] = float(case.load.speed)
     write_text_atomic(out / "case.toml", case_to_toml(case))
