@@ -33,6 +33,7 @@ from .paper_values import faulty_words as _faulty_words
 from .report import Report
 
 __all__ = ["report_stage", "write_results_netcdf", "ERRATA", "CITATIONS", "disagreements",
+           "case_sections", "citations", "used_case", "quick_sentence",
            "model_comparison_statements", "TABLE_MODELS"]
 
 ERRATA = [
@@ -126,8 +127,50 @@ def _versions() -> list[tuple[str, str]]:
     return package_versions()
 
 
+#: Case values that count something, by key, with the unit shown after the count: the schema
+#: holds them as floats (``simulation.max_steps = 1e8``), the report as integers.
+COUNT_UNITS = {"simulation.max_steps": "steps"}
+
+
+def _tidy_quantity(value) -> str:
+    """A value of a fault entry as case.toml writes it (``"0.0001 m"``), its number to 12
+    significant digits (``"2.9999999999999997e-05 m"`` -> ``"3e-05 m"``)."""
+    if isinstance(value, float):
+        return f"{value:.12g}"
+    text = str(value)
+    number, _, unit = text.partition(" ")
+    try:
+        x = float(number)
+    except ValueError:
+        return text
+    return f"{x:.12g} {unit}".strip()
+
+
+def _faults_text(entries) -> str:
+    """A faults list (case.toml's ``[[faults]]`` tables) as the report shows it: one ``key =
+    value`` list per fault, with units, fields left unset omitted, faults separated by "; ";
+    "none" for an empty list."""
+    return "; ".join(", ".join(f"{k} = {_tidy_quantity(v)}" for k, v in entry.items()
+                               if v is not None)
+                     for entry in entries) or "none"
+
+
+def _value_text(key: str, value) -> str:
+    """A case value (as case.toml holds it: quantities as SI unit strings) as the case table
+    shows it: a faults list as :func:`_faults_text`, a count of :data:`COUNT_UNITS` as an
+    integer with its unit, an unset value as "not set"; no Python ``None`` or list/dict repr."""
+    if value is None:
+        return "not set"
+    if key in COUNT_UNITS and isinstance(value, (int, float)) and float(value).is_integer():
+        return f"{int(value):,} {COUNT_UNITS[key]}"
+    if isinstance(value, list) and all(isinstance(v, dict) for v in value):
+        return _faults_text(value)
+    return str(value)
+
+
 def _case_rows(case: Case) -> list[tuple[str, str, str]]:
-    """(key, value, source) for every value of the case, in file order."""
+    """(key, value, source) for every value of the case, in file order; values as
+    :func:`_value_text` renders them (SI, with units)."""
     text = case_to_toml(case)
     import tomllib
 
@@ -140,12 +183,12 @@ def _case_rows(case: Case) -> list[tuple[str, str, str]]:
             if isinstance(v, dict) and not ("value" in v and set(v) <= {"value", "source"}):
                 walk(v, key)
             elif isinstance(v, dict):
-                rows.append((key, str(v["value"]), v.get("source", "")))
+                rows.append((key, _value_text(key, v["value"]), v.get("source", "")))
             elif key in ("name", "description", "extends"):
                 continue
             else:
-                rows.append((key, str(v), case.provenance.get(key, "geardyn default "
-                                                                    "(schema default)")))
+                rows.append((key, _value_text(key, v),
+                             case.provenance.get(key, "geardyn default (schema default)")))
 
     walk(data, "")
     return rows
@@ -175,16 +218,23 @@ SHIPPED_NOTE_INPUTS = {
 }
 
 
-def _case_table_rows(case: Case, changed: list[str]) -> list[tuple[str, str, str]]:
+def _case_table_rows(case: Case, changed: list[str],
+                     used: Case | None = None) -> list[tuple[str, str, str]]:
     """:func:`_case_rows` as the report shows them: a section switched off (``enabled =
     false``) says its values are not used, and a note carried over from the shipped case whose
     inputs ``changed`` (keys of the differences from it) is marked as the shipped case's, with
-    the shipped values it was written for."""
+    the shipped values it was written for. A value the run did not use (``used``: the case as
+    the run simulated and mapped it, e.g. with ``--quick``'s shorter records) is shown as the
+    case's and the one used: ``"1.0 s; used with --quick: 0.3 s"``."""
     from ..config import paper_case
 
     ref_case = paper_case()
     ref = {k: (v, s) for k, v, s in _case_rows(ref_case)}
     rows = _case_rows(case)
+    if used is not None:
+        ran = {k: v for k, v, _ in _case_rows(used)}
+        rows = [(k, v if ran.get(k, v) == v else f"{v}; used with --quick: {ran[k]}", s)
+                for k, v, s in rows]
     off = {k.rsplit(".", 1)[0] for k, v, _ in rows
            if k.endswith(".enabled") and v == "False"}
     out = []
@@ -201,6 +251,55 @@ def _case_table_rows(case: Case, changed: list[str]) -> list[tuple[str, str, str
                 source = f"{source} [note of the shipped case, for its {was}: not about this case]"
         out.append((key, value, source))
     return out
+
+
+def used_case(case: Case, s: dict) -> Case:
+    """The case as the run simulated and mapped it: ``case`` with the settings ``--quick``
+    changed (``summary["quick_settings"]``, SI values); ``case`` itself without them."""
+    changed = {d["key"]: d["used"] for d in s.get("quick_settings", [])}
+    return case.with_overrides(changed, source="--quick") if changed else case
+
+
+def quick_sentence(case: Case, s: dict) -> str:
+    """What ``--quick`` changed, with the numbers (e.g. "--quick shortened the records and
+    coarsened the stiffness maps: simulation.record_time = 0.3 s (the case: 1.0 s), ..."); ""
+    when it changed nothing."""
+    changed = [d["key"] for d in s.get("quick_settings", [])]
+    if not changed:
+        return ""
+    was = {k: v for k, v, _ in _case_rows(case)}
+    now = {k: v for k, v, _ in _case_rows(used_case(case, s))}
+    what = [w for w, prefix in (("shortened the records", "simulation."),
+                                ("coarsened the stiffness maps", "stiffness."))
+            if any(k.startswith(prefix) for k in changed)]
+    return (f"--quick {' and '.join(what) or 'changed numerical settings'}: "
+            + ", ".join(f"{k} = {now.get(k)} (the case: {was.get(k)})" for k in changed) + ".")
+
+
+#: Differences (:func:`~.paper_values.case_differences`) whose value is computed for the run,
+#: not read from case.toml, with their SI unit: shown as the number and the unit.
+_COMPUTED_UNITS = {"stiffness.fe.torque": "N m"}
+
+
+def _difference_text(key: str, value, case: Case) -> str:
+    """A value of the differences tables as the case table shows it, with its unit: read from
+    ``case`` (the paper's, this case or the case as run) when case.toml holds it, so a faults
+    list reads as its fields and the paper's empty one as "none"."""
+    from .report import fmt
+
+    if isinstance(value, bool):
+        return fmt(value)
+    if key in _COMPUTED_UNITS:
+        return "not set" if value is None else f"{fmt(value)} {_COMPUTED_UNITS[key]}"
+    shown = {k: v for k, v, _ in _case_rows(case)}
+    if key == "faults":
+        text = shown.get(key, "none")
+        if text == "none" and case.crack is not None and case.crack.active:
+            text = (f"none besides the [crack] section's {_fault_description(case)}")
+        return text
+    if key in shown:
+        return shown[key]
+    return _value_text(key, _set_fields(value))
 
 
 def _get(case: Case, key: str):
@@ -578,6 +677,65 @@ def _own_case_title(case: Case, diffs: list[dict]) -> tuple[str, str]:
             "values")
 
 
+def case_sections(rep: Report, case: Case, s: dict) -> Case:
+    """The report's sections on the case: what differs from the paper's case (inputs, then the
+    numerical settings as the run used them) and every value of the case with its source, the
+    values ``--quick`` changed shown as the case's and the one used.
+
+    Parameters
+    ----------
+    rep : Report
+        The report the sections are added to.
+    case : Case
+        The user's case (as case.toml holds it).
+    s : dict
+        The summary: ``differences_from_paper``, ``numerical_differences`` and
+        ``quick_settings`` (:func:`geardyn.studies.paper.run_paper_study`).
+
+    Returns
+    -------
+    Case
+        The case as the run simulated and mapped it (:func:`used_case`).
+    """
+    from ..config import paper_case
+
+    diffs = s.get("differences_from_paper", [])
+    numerical = s.get("numerical_differences", [])
+    ref_case, run_case = paper_case(), used_case(case, s)
+    if diffs:
+        rep.heading("What differs from the paper's case")
+        rep.paragraph("These inputs differ from Xue & Howard's case (SI values), so this "
+                      "report does not compare its results with the paper's.")
+        rep.table(["key", "paper's case", "this case"],
+                  [[d["key"], _difference_text(d["key"], d["paper"], ref_case),
+                    _difference_text(d["key"], d["case"], case)] for d in diffs],
+                  left_columns=1)
+    if numerical:
+        rep.table(["numerical setting", "paper case's default", "this run"],
+                  [[d["key"], _difference_text(d["key"], d["paper"], ref_case),
+                    _difference_text(d["key"], d["case"], run_case)
+                    + (f" (--quick; the case: "
+                       f"{_difference_text(d['key'], d['without_quick'], case)})"
+                       if "without_quick" in d else "")] for d in numerical],
+                  left_columns=1,
+                  caption="Numerical settings that differ from the shipped case, as this run "
+                          "used them (they change the resolution or the method, not the case)")
+
+    rep.heading("The case and every assumption")
+    rep.paragraph("Every value of the case with its source. Values marked 'geardyn default' "
+                  "(in amber) are not given by the paper; the source says what geardyn chose "
+                  "and why.")
+    quick = quick_sentence(case, s)
+    if quick:
+        rep.note(f"{quick} The table shows such a value as the case's and the one used ('used "
+                 "with --quick'); case.toml holds the case as given, without them. Run without "
+                 "--quick for the case's own settings.")
+    rows = _case_table_rows(case, [d["key"] for d in diffs], used=run_case)
+    rep.table(["key", "value (SI)", "source"], rows, left_columns=3,
+              classes=[["", "", "assume" if r[2].startswith("geardyn") else ""] for r in rows])
+    return run_case
+
+
 def fault_event_words(s: dict, faulty_pair: bool, faulty: str, fault: str) -> str:
     """Where the Figs. 8-10 analogues are centred, for their captions: around the first fault
     event when the study located it (summary keys ``fault_event_angle_deg`` and
@@ -662,35 +820,16 @@ def report_stage(case: Case, out: Path, result: StudyResult) -> None:
                if s.get("crack_angle_deg") is not None and _fault_word(case) else "")
             + f" {n_check} of {len(checks)} consistency checks pass.")
     if result.quick:
-        rep.note("This is a --quick run: shorter records (fewer revolutions averaged). Run "
+        rep.note("This is a --quick run: shorter records (fewer revolutions averaged)"
+                 + (", coarser stiffness maps" if any(d["key"].startswith("stiffness.") for d in
+                                                     s.get("quick_settings", [])) else "")
+                 + "; the values used are under 'The case and every assumption'. Run "
                  "'geardyn run' without --quick for the full study.")
     for n in result.notes:
         rep.note(n)
 
-    # ---------------------------------------------------------------- differences
-    diffs = s.get("differences_from_paper", [])
-    numerical = s.get("numerical_differences", [])
-    if diffs:
-        rep.heading("What differs from the paper's case")
-        rep.paragraph("These inputs differ from Xue & Howard's case (SI values), so this "
-                      "report does not compare its results with the paper's.")
-        rep.table(["key", "paper's case", "this case"],
-                  [[d["key"], _set_fields(d["paper"]), _set_fields(d["case"])] for d in diffs],
-                  left_columns=1)
-    if numerical:
-        rep.table(["numerical setting", "paper case's default", "this run"],
-                  [[d["key"], d["paper"], d["case"]] for d in numerical], left_columns=1,
-                  caption="Numerical settings that differ from the shipped case (they change "
-                          "the resolution or the method, not the case)")
-
-    # ---------------------------------------------------------------- case
-    rep.heading("The case and every assumption")
-    rep.paragraph("Every value of the case with its source. Values marked 'geardyn default' "
-                  "(in amber) are not given by the paper; the source says what geardyn chose "
-                  "and why.")
-    rows = _case_table_rows(case, [d["key"] for d in s.get("differences_from_paper", [])])
-    rep.table(["key", "value (SI)", "source"], rows, left_columns=3,
-              classes=[["", "", "assume" if r[2].startswith("geardyn") else ""] for r in rows])
+    # ---------------------------------------------------------------- differences, case
+    run_case = case_sections(rep, case, s)
 
     rep.heading("Corrections to the paper that geardyn applies")
     rep.bullets(ERRATA)
@@ -723,8 +862,8 @@ def report_stage(case: Case, out: Path, result: StudyResult) -> None:
            "+ trochoid tooth, fillet-foundation of Sainsot et al.)")
     grid = result.maps.get("healthy")
     dd = (np.asarray(grid.dd, dtype=float) if grid is not None else
-          np.linspace(case.stiffness.centre_distance_min, case.stiffness.centre_distance_max,
-                      case.stiffness.centre_distances))
+          np.linspace(run_case.stiffness.centre_distance_min,
+                      run_case.stiffness.centre_distance_max, run_case.stiffness.centre_distances))
     rep.paragraph(
         f"Method: {how}, face width {case.pair.face_width * 1e3:g} mm, "
         f"E = {case.material.youngs_modulus / 1e9:g} GPa. The map covers centre distance "
@@ -895,18 +1034,38 @@ def report_stage(case: Case, out: Path, result: StudyResult) -> None:
     rep.table(["package", "version"], _versions(), caption="Versions")
     rep.paragraph(f"Command line: {command_line()}.")
     rep.heading("Citations")
-    cites = list(CITATIONS)
-    for m in result.maps.values():
-        c = m.attrs.get("citations")
-        for text in (json.loads(c) if isinstance(c, str) else (c or [])):
-            if text not in cites:
-                cites.append(text)
-    rep.bullets(cites)
+    rep.bullets(citations(result.maps.values()))
     rep.write(footer=f"geardyn {__version__}.")
     s["figures"] = sorted(p.name for p in rep.figures)
     s["output_size_bytes"] = {"results.nc": (out / "results.nc").stat().st_size,
                               "results.nc + runs": total_nc}
     result.emit("report: report.html", n_fig + 2, n_fig + 2)
+
+
+def _citation_key(text: str) -> tuple[str, str]:
+    """(first author's surname, year) of a citation, in the full form of :data:`CITATIONS`
+    ("Yang, D. C. H. & Lin, J. Y. (1987). ...") or the maps' short form ("Yang & Lin 1987,
+    ...")."""
+    import re
+
+    name = re.match(r"[^\W\d_][\w'-]*", text)
+    year = re.search(r"\b(1[89]\d\d|20\d\d)\b", text)
+    return (name.group(0) if name else text, year.group(1) if year else "")
+
+
+def citations(maps) -> list[str]:
+    """The report's citations: :data:`CITATIONS`, then those the stiffness ``maps`` cite
+    (their ``citations`` attribute) that it does not hold already, each work once, in its full
+    form where :data:`CITATIONS` has one (a work is matched by its first author and year)."""
+    cites = list(CITATIONS)
+    known = {_citation_key(c) for c in cites}
+    for m in maps:
+        c = m.attrs.get("citations")
+        for text in (json.loads(c) if isinstance(c, str) else (c or [])):
+            if _citation_key(text) not in known:
+                cites.append(text)
+                known.add(_citation_key(text))
+    return cites
 
 
 def _rows_table(rep: Report, rows: list[dict], ref_label: str) -> None:
