@@ -237,3 +237,67 @@ def test_static_te_refuses_what_is_not_a_case(kmap):
 @pytest.mark.parametrize("n", [0, -3, 2.5])
 def test_static_te_refuses_bad_point_counts(case, kmap, n):
     _refused(lambda: static_te_of_case(case, 1.0, stiffness_map=kmap, errors=False, n=n), "n")
+
+
+# ------------------------------------------- a second user audit (2026-11-27), the API's side
+SMALL = {"stiffness.method": "pem", "stiffness.centre_distances": 3,
+         "stiffness.nodes_per_segment": 6, "simulation.record_time": "0.05 s",
+         "simulation.settle_time": "0.01 s"}
+
+
+def test_map_method_in_any_case_and_flags_that_are_not_bools(case):
+    small = case.with_overrides(SMALL)
+    assert build_map(small, method=" PEM ", cracked=False).attrs["method"] == "pem"
+    for kwargs, field in (({"method": "xyz"}, "method"), ({"cracked": "no"}, "cracked"),
+                          ({"cracked": 1}, "cracked")):
+        with pytest.raises(InputError) as info:
+            build_map(small, **kwargs)
+        assert info.value.field == field, str(info.value)
+    from geardyn.dynamics import simulate
+
+    with pytest.raises(InputError) as info:
+        simulate(small, cracked="no")  # "no" is not taken for True
+    assert info.value.field == "cracked"
+
+
+def test_measure_refuses_what_is_not_a_case():
+    from geardyn.studies.measure import measure
+
+    with pytest.raises(InputError) as info:
+        measure("x")
+    assert info.value.field == "case" and "not a str" in str(info.value)
+
+
+def test_diagnose_file_takes_a_rate_with_its_unit_and_names_a_missing_file(tmp_path):
+    from geardyn.diagnostics import diagnose_file
+    from geardyn.errors import DataFileError
+
+    fs, f_shaft, z = 20_000.0, 20.0, 23
+    t = np.arange(int(2.0 * fs)) / fs
+    acc = np.sin(2 * np.pi * z * f_shaft * t) + 0.3 * np.sin(2 * np.pi * 2 * z * f_shaft * t)
+    tach = (np.mod(f_shaft * t, 1.0) < 0.05).astype(float)  # one pulse a revolution
+    path = tmp_path / "syn.csv"
+    np.savetxt(path, np.column_stack([acc, tach]), delimiter=",", header="acc,tach", comments="")
+    opts = {"signals": ["acc"], "tach": "tach", "teeth": z}
+    a = diagnose_file(path, fs="20 kHz", **opts).to_dict()["signals"]["acc"]
+    b = diagnose_file(path, fs=fs, **opts).to_dict()["signals"]["acc"]
+    assert a["n_averages"] == b["n_averages"] >= 30
+    assert a["kurtosis"] == b["kurtosis"]
+    with pytest.raises(InputError) as info:
+        diagnose_file(path, fs="20 rpm", **opts)  # a speed, not a sample rate
+    assert info.value.field == "fs"
+    with pytest.raises(DataFileError):  # the file first, not "signals: got None"
+        diagnose_file(tmp_path / "missing.csv")
+
+
+def test_diagnose_file_refuses_a_tach_for_a_simulation_record(case, tmp_path):
+    from geardyn.diagnostics import diagnose_file
+    from geardyn.dynamics import simulate
+    from geardyn.io import write_netcdf_atomic
+
+    rec = tmp_path / "sim.nc"
+    write_netcdf_atomic(simulate(case.with_overrides(SMALL)), rec)
+    for kwargs, field in (({"tach": "omega_p"}, "tach"), ({"angle": "theta_g"}, "angle")):
+        with pytest.raises(InputError) as info:
+            diagnose_file(rec, **kwargs)
+        assert info.value.field == field and "exact pinion angle" in info.value.allowed

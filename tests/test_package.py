@@ -21,6 +21,19 @@ def test_every_public_name_is_the_object_its_module_defines():
     assert geardyn.paper_case is paper_case and geardyn.GearPair is GearPair
     assert geardyn.centre_distance_from_displacements is centre_distance_from_displacements
     assert geardyn.InputError is InputError and issubclass(geardyn.InputError, GeardynError)
+    # the entry points a scripter starts from (help(geardyn) lists them; a user audit of
+    # 2026-11-27 found none of them at the top level)
+    from geardyn.diagnostics import diagnose, diagnose_file
+    from geardyn.dynamics import simulate
+    from geardyn.static_te import static_te_of_case
+    from geardyn.stiffness import build_map
+    from geardyn.studies.measure import measure
+    from geardyn.studies.paper import run_paper_study
+
+    for fn in (build_map, simulate, diagnose, diagnose_file, measure, static_te_of_case,
+               run_paper_study):
+        assert getattr(geardyn, fn.__name__) is fn
+        assert f"geardyn.{fn.__name__}" in geardyn.__doc__, fn.__name__
     with pytest.raises(AttributeError, match="no attribute 'nope'"):
         geardyn.nope  # noqa: B018
 

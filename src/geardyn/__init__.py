@@ -4,6 +4,18 @@ Implements Xue & Howard (2018), "Dynamic modelling of flexibly supported gears u
 convergence of tooth mesh stiffness", end to end: geometry, mesh stiffness, the 6-DOF model I / II
 dynamics and gear diagnostics.
 
+Where to start (each documented with its units; ``help(geardyn.simulate)``)::
+
+    case = geardyn.paper_case()               # or geardyn.load_case("my_case.toml")
+    k = geardyn.build_map(case)               # mesh stiffness K(theta, centre distance) [N/m]
+    record = geardyn.simulate(case, k)        # model II by default: an xarray Dataset, SI units
+    result = geardyn.diagnose_file("rec.nc")  # TSA, residual, FM0/FM4/NA4..., as the CLI does
+    m = geardyn.measure(case)                 # a housing accelerometer and a tachometer
+    te = geardyn.static_te_of_case(case)      # loaded static transmission error
+
+``geardyn.diagnose`` takes signals already in memory; ``geardyn.run_paper_study`` is
+``geardyn run`` as a function.
+
 The names below are imported on first use (PEP 562): ``import geardyn`` alone loads neither
 the case models (pydantic) nor the geometry, so that a process that needs one part of geardyn
 (the report's figure process, the kernel's compiler, a CLI refusal) does not import the rest.
@@ -18,8 +30,14 @@ from ._version import __version__
 
 if TYPE_CHECKING:  # for type checkers and IDEs; at run time see __getattr__
     from .config import Case, load_case, paper_case
+    from .diagnostics import diagnose, diagnose_file
+    from .dynamics import simulate
     from .errors import DataFileError, GeardynError, GeometryError, InputError, NumericalError
     from .geometry import Gear, GearPair, OperatingGeometry, centre_distance_from_displacements
+    from .static_te import static_te_of_case
+    from .stiffness import build_map
+    from .studies.measure import measure
+    from .studies.paper import run_paper_study
 
 #: Public name -> the submodule that defines it.
 _LAZY = {
@@ -28,6 +46,9 @@ _LAZY = {
     "centre_distance_from_displacements": "geometry",
     "GeardynError": "errors", "InputError": "errors", "GeometryError": "errors",
     "NumericalError": "errors", "DataFileError": "errors",
+    "build_map": "stiffness", "simulate": "dynamics", "diagnose": "diagnostics",
+    "diagnose_file": "diagnostics", "measure": "studies.measure",
+    "static_te_of_case": "static_te", "run_paper_study": "studies.paper",
 }
 
 __all__ = [
@@ -44,6 +65,13 @@ __all__ = [
     "GeometryError",
     "NumericalError",
     "DataFileError",
+    "build_map",
+    "simulate",
+    "diagnose",
+    "diagnose_file",
+    "measure",
+    "static_te_of_case",
+    "run_paper_study",
 ]
 
 

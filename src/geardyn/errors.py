@@ -31,6 +31,15 @@ class _NotGiven:
 NOT_GIVEN: Any = _NotGiven()
 
 
+def check_flag(value: Any, field: str) -> bool:
+    """``value`` as a bool if it is one (Python's or NumPy's), else :class:`InputError` naming
+    ``field``: a string such as ``"no"`` is not taken for True."""
+    t = type(value)
+    if isinstance(value, bool) or (t.__module__ == "numpy" and t.__name__ in ("bool", "bool_")):
+        return bool(value)
+    raise InputError(field, value, "True or False")
+
+
 def _clip(text: str, limit: int) -> str:
     """One line of at most ``limit`` characters (control characters shown as one space)."""
     text = _CONTROL.sub(" ", text)
@@ -65,6 +74,7 @@ __all__ = [
     "NumericalError",
     "DataFileError",
     "short_repr",
+    "check_flag",
 ]
 
 

@@ -72,6 +72,9 @@ def test_every_figure_has_units_and_renders(products):
     assert "v_yg [m/s]" in _labels(figs["tsa"])
     assert "RMS amplitude [dB re 1 m/s]" in _labels(figs["spectrum"])
     assert "shaft order [-]" in _labels(figs["pwvd"])
+    # a signal whose unit is not known is not labelled dimensionless (a user audit, 11-27)
+    assert "PWVD [unit not given]" in _labels(plot_pwvd(pwvd(X, max_order=40)))
+    assert "acc [unit not given]" in _labels(plot_tsa(X[:64], label="acc"))
     assert "PM [deg]" in _labels(figs["demodulation"])
     assert "real part [m/s]" in _labels(figs["analytic"])
     # mesh harmonics marked on the spectrum: dashed lines at 23, 46, ...

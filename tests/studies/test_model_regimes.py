@@ -261,10 +261,6 @@ def test_tiny_study_structure(tiny):
                               "convergence_signal": len(MAIN_SIGNALS), "runup_window": 60,
                               "runup_signal": len(MAIN_SIGNALS)}
     assert ds.crack_depth.values.tolist() == [5e-3] and ds.damping_ratio.values.tolist() == [0.05]
-    for name, var in ds.variables.items():
-        if name not in ("signal", "convergence_signal", "runup_signal", "runup_window",
-                        "error"):
-            assert "units" in var.attrs, name
     # k = 1e5 N/m: not run, NaN
     assert np.all(ds.status_ii.values[..., 0, :] == NOT_RUN)
     assert np.all(np.isnan(ds.ratio_max.values[..., 0, :]))
@@ -280,6 +276,30 @@ def test_tiny_study_structure(tiny):
     assert np.all(ds.convergence_error_predictor.values[-1] == 0)
     assert ("time-step check", 1, 1) in stages and ("simulations", 4, 4) in stages
     assert stages[-1] == ("run-up", 2, 2) and ds.attrs["runup_status"] == "ok"
+
+
+@pytest.mark.slow
+def test_tiny_study_netcdf_has_units_and_long_name_everywhere(tiny):
+    """Every data variable and coordinate of model_regimes.nc (written as the CLI writes it)
+    has a non-empty ``units`` ("1" for dimensionless numbers and labels) and ``long_name``."""
+    from geardyn.io import write_netcdf_atomic
+
+    ds, _, tmp = tiny
+    path = tmp / "model_regimes.nc"
+    write_netcdf_atomic(ds, path)
+    with xr.open_dataset(path) as nc:
+        names = list(nc.data_vars) + list(nc.coords)
+        # the label and index coordinates and the error messages are in the file
+        assert {"signal", "convergence_signal", "runup_signal", "runup_window",
+                "error"} <= set(names)
+        missing = [(n, a) for n in names for a in ("units", "long_name")
+                   if not str(nc[n].attrs.get(a, "")).strip()]
+        assert missing == []
+        for n in ("signal", "convergence_signal", "runup_signal", "runup_window", "error",
+                  "ratio_max", "status_ii"):
+            assert nc[n].attrs["units"] == "1", n
+        assert nc["pinion_speed"].attrs["units"] == "rad/s"
+        assert nc["convergence_dt"].attrs["units"] == "s"
 
 
 @pytest.mark.slow
@@ -353,3 +373,26 @@ def test_summary_says_where_it_exceeds():
     assert s["crack_effect"] == pytest.approx(0.20)
     row = s["by_stiffness"][1]
     assert row[4] == 1 and row[6] == "100"
+
+
+def test_page_says_one_stiffness_above_as_one_value(tmp_path):
+    """The points above the threshold at one bearing stiffness: '1e+07 N/m', not the range
+    '1e+07..1e+07 N/m'; at two stiffnesses the range stays."""
+    import re
+
+    r = np.full((2, 1, 2, 3), 0.05)
+    r[1, 0, 1, 2] = 0.25
+    one = write_report(_synthetic(r), tmp_path / "one", command="test").read_text()
+    said = re.findall(r"have bearing stiffness ([^ ]+) N/m", one)
+    assert said == ["1e+07"]
+    # the first stiffness run as well, and above the threshold at one point
+    ds = _synthetic(r)
+    for v in ("status_ii", "status_i_static", "status_ii_start"):
+        ds[v][:, :, 0, :] = 0
+    for v in ("iterating_fraction", "max_iterations", "steps_without_fixed_point",
+              "start_steps_without_fixed_point"):
+        ds[v][:] = 0.0
+    ds["ratio_max"][1, 0, 0, 2] = 0.3
+    ds["rms_ii_minus_i_static"][:, 1, 0, 0, 2] = 0.3
+    two = write_report(ds, tmp_path / "two", command="test").read_text()
+    assert re.findall(r"have bearing stiffness ([^ ]+) N/m", two) == ["1e+05..1e+07"]

@@ -40,7 +40,7 @@ def model_ii(
                                                           "model_regimes.html, figures/.",
                                       show_default=False)],
     quick: Annotated[bool, typer.Option(
-        "--quick", help="The coarse shipped grid (64 runs, about a minute on 2 cores) instead "
+        "--quick", help="The coarse shipped grid (64 runs, about 22 s on a 2-core machine) instead "
                         "of the full one (1260 runs).")] = False,
     sweep_file: Annotated[Path | None, typer.Option(
         "--sweep", help="Your own sweep file over the study's axes (crack.depth, "

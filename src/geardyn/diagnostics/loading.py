@@ -235,7 +235,12 @@ def load_measurement(
     n = next(iter(signals.values())).shape[0]
 
     fs_, time_ = name_of("fs"), name_of("time")
-    if fs is not None and not (np.isfinite(fs) and fs > 0):
+    if isinstance(fs, str):  # "20 kHz", as the command line's --fs
+        from ..units import parse_frequency
+
+        fs = parse_frequency(fs, fs_)
+    if fs is not None and not (isinstance(fs, int | float | np.integer | np.floating)
+                               and np.isfinite(fs) and fs > 0):
         raise InputError(fs_, fs, "a positive sample rate in Hz")
     if fs is not None and time is not None:
         # the time column would win (tach edges, tsa) and fs be ignored without a word

@@ -157,7 +157,9 @@ class SignalDiagnosis:
             "demodulation": {
                 "carrier_order": dem.carrier_order,
                 "band": list(dem.band),
-                "mean_phase_deg": _f(float(np.degrees(np.mean(dem.pm)))),
+                # the carrier's mean phase, wrapped to (-180, 180] deg: where the band holds
+                # no carrier the unwrapped phase drifts, and its mean read -346.5 or 733 deg
+                "mean_phase_deg": _f(_wrapped_deg(float(np.mean(dem.pm)))),
                 "mean_am": _f(float(np.mean(dem.am))),
                 "envelope_excludes_carrier": dem.envelope_excludes_carrier,
             },
@@ -613,13 +615,28 @@ def diagnose_file(
         See :func:`load_simulation`, :func:`load_measurement` and :func:`diagnose`.
     """
     name_of = _namer(option_names)
+    if not Path(path).exists():  # before any argument that only the file's content decides
+        raise DataFileError(path, "no such file")
     if teeth is not None:
         _check_int(teeth, name_of("teeth"), 1, "a positive integer number of teeth")
+    if isinstance(fs, str):  # "20 kHz", as the command line's --fs
+        from ..units import parse_frequency
+
+        fs = parse_frequency(fs, name_of("fs"))
+    netcdf = Path(path).suffix.lower() in NETCDF_SUFFIXES
+    if netcdf and (tach is not None or angle is not None) and _is_simulation_record(path):
+        # its exact angle theta_p is what a tach or angle channel would approximate (and the
+        # measured-data reading then asked for --signal and --fs: a user audit, 2026-11-27)
+        given, value = ("tach", tach) if tach is not None else ("angle", angle)
+        raise InputError(name_of(given), value,
+                         f"no {name_of('tach')} or {name_of('angle')} for a geardyn simulation "
+                         f"record: {Path(path).name} is averaged on its exact pinion angle "
+                         f"(theta_p); they are for measured data (a geardyn measure file, a "
+                         f"DAQ's file)")
     # a NetCDF file is read as a geardyn simulation (exact angle theta_p) unless the shaft angle
     # is given as for measured data (a tach or angle channel): then any NetCDF file of 1-D
     # channels (e.g. written by geardyn measure or a DAQ) reads like a CSV, fs from its attribute
-    simulation = (Path(path).suffix.lower() in NETCDF_SUFFIXES and tach is None
-                  and angle is None)
+    simulation = netcdf and tach is None and angle is None
     if simulation:
         sig = None if signals is None else ([signals] if isinstance(signals, str)
                                             else [str(s) for s in signals])
@@ -671,6 +688,29 @@ def diagnose_file(
         raise _short_record(path, m, exc, simulation) from None
     except InputError as exc:
         raise _renamed(exc, name_of) from None
+
+
+def _wrapped_deg(phase: float) -> float:
+    """``phase`` [rad] in degrees, wrapped to (-180, 180]."""
+    deg = math.degrees(math.remainder(phase, 2.0 * math.pi))
+    return 180.0 if deg == -180.0 else deg
+
+
+def _is_simulation_record(path) -> bool:
+    """Whether the NetCDF file ``path`` is a geardyn simulation record (``theta_p`` and the
+    ``pinion_teeth`` attribute); False for any other file, readable or not (its reader says
+    what is wrong with it)."""
+    from ..io import NETCDF_LOCK, open_netcdf
+
+    try:
+        with NETCDF_LOCK:  # from the file's opening to its closing
+            ds = open_netcdf(path)
+            try:
+                return "theta_p" in ds.variables and "pinion_teeth" in ds.attrs
+            finally:
+                ds.close()
+    except Exception:  # noqa: BLE001 - not a readable NetCDF file: not a simulation record
+        return False
 
 
 #: Arguments of :func:`diagnose` named by the :func:`diagnose_file` argument they come from

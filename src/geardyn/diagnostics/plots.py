@@ -30,8 +30,13 @@ def _figure(figsize):
     return Figure(figsize=figsize, layout="constrained")
 
 
+#: An axis label's unit where the data gave none (a CSV without a unit row): not "[-]", which
+#: would say the signal is dimensionless.
+NO_UNIT = "unit not given"
+
+
 def _unit(unit: str) -> str:
-    return f" [{unit}]" if unit else " [-]"
+    return f" [{unit or NO_UNIT}]"
 
 
 def _angle_axis(n: int) -> np.ndarray:
@@ -180,7 +185,7 @@ def plot_pwvd(result: PWVDResult, *, max_order: float | None = None, teeth: int 
         max_order = min(orders[-1], 6 * teeth + 0.5 * teeth) if teeth else orders[-1]
     sel = orders <= max_order
     img = np.maximum(dist[:, sel], 0.0).T
-    cbar_label = f"PWVD [({unit})^2]" if unit else "PWVD [-]"
+    cbar_label = f"PWVD [({unit})^2]" if unit else f"PWVD [{NO_UNIT}]"
     if scale == "db":
         peak = img.max() if img.size and img.max() > 0 else 1.0
         img = 10 * np.log10(np.maximum(img / peak, 1e-6))

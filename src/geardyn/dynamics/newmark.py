@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import GeardynError, InputError, NumericalError
+from ..errors import GeardynError, InputError, NumericalError, check_flag
 from ..run_limits import check_bounded_work, check_record_size  # noqa: F401 - re-exported
 from ..stiffness.map import MapArrays, StiffnessMap
 from . import _kernel as K
@@ -516,6 +516,7 @@ def simulate(case, stiffness_map: StiffnessMap | None = None, *, model: str | No
         (attribute ``complete = 0``).
     """
     which = check_arguments(case, stiffness_map, model)
+    cracked = check_flag(cracked, "cracked")
     if case.simulation.dynamics == "transverse":
         from .transverse import simulate_transverse
 

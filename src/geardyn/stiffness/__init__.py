@@ -91,7 +91,7 @@ def build_map(case, *, method: str | None = None, cracked: bool = True,
     ----------
     case : geardyn.config.Case
     method : {"pem", "fe"}, optional
-        Default: ``case.stiffness.method``.
+        Any case; default: ``case.stiffness.method``.
     cracked : bool
         Include the case's crack (if it has an enabled one) and its ``faults`` list; ``False``
         gives the healthy map. The FE method refuses the faults it does not model, naming the
@@ -115,9 +115,16 @@ def build_map(case, *, method: str | None = None, cracked: bool = True,
     if not isinstance(case, Case):
         raise InputError("case", case, "a geardyn.config.Case (geardyn.load_case(path) or "
                                        "geardyn.paper_case())")
-    method = method or case.stiffness.method
-    if not isinstance(method, str) or method not in MODEL_VERSIONS:
-        raise InputError("stiffness.method", method, "'pem' or 'fe'")
+    from ..errors import check_flag
+
+    cracked = check_flag(cracked, "cracked")
+    if method is None:
+        method = case.stiffness.method
+    elif isinstance(method, str) and method.strip().lower() in MODEL_VERSIONS:
+        method = method.strip().lower()  # any case, as simulate's model and the CLI's options
+    else:
+        raise InputError("method", method, "'pem' or 'fe' (any case), or None for the case's "
+                                           "stiffness.method")
     if cracked:  # a method that cannot model a fault of the case says so (geardyn.faults)
         from ..faults import check_method
 

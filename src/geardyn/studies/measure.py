@@ -131,8 +131,13 @@ def measure(case: Case, stiffness_map=None, *, model: str | None = None, cracked
     from .. import _version
     from ..config import case_to_toml
     from ..dynamics import simulate
+    from ..errors import InputError, check_flag
     from ..measurement.record import to_dataset
 
+    if not isinstance(case, Case):  # as simulate() says it, before the chain reads the case
+        raise InputError("case", case, "a geardyn.config.Case (geardyn.load_case(path) or "
+                                       f"geardyn.paper_case()), not a {type(case).__name__}")
+    cracked = check_flag(cracked, "cracked")
     chain = chain_from_config(case.measurement)
     if stiffness_map is None:
         from ..stiffness import build_map

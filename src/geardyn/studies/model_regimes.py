@@ -432,8 +432,9 @@ def evaluation_convergence(case, stiffness_map, refinements: Sequence[int] = (1,
     Returns
     -------
     xarray.Dataset
-        Dimensions ``dt`` [s] and ``signal``: ``error_predictor``, ``error_start``
-        (``RMS(II_ref - II) / STD(II_ref)``) and ``rms_ii_minus_i_static`` at each step [-].
+        Dimensions ``dt`` [s] and ``signal`` (labels, units "1"): ``error_predictor``,
+        ``error_start`` (``RMS(II_ref - II) / STD(II_ref)``) and ``rms_ii_minus_i_static`` at
+        each step [-].
 
     Raises
     ------
@@ -487,7 +488,8 @@ def evaluation_convergence(case, stiffness_map, refinements: Sequence[int] = (1,
                                                  "- I-static) / STD(II predictor) at this step"})},
         coords={"dt": ("dt", dt0 / np.asarray(refinements, float), {"units": "s",
                                                                      "long_name": "time step"}),
-                "signal": ("signal", list(signals))},
+                "signal": ("signal", list(signals), {"units": "1",
+                                                     "long_name": "compared record variable"})},
         attrs={"reference": f"model II, predictor evaluation, dt = {dt0 / refinements[-1]:.6g} s",
                "recorded_samples": int(n)})
 
@@ -653,10 +655,13 @@ def model_regimes(out: str | os.PathLike, *, sweep=None, quick: bool = False, ca
         ``rms_ii_minus_ii_start`` (signal, ...) [-]; ``ratio_max`` [-]; the per-run scalars of
         :class:`ModelRegimeEvaluator` (the status variables are int8, a run the sweep recorded
         as failed is 9); ``mode_frequency`` [Hz] and ``mode_decay_rate`` [1/s]; coordinate
-        ``mesh_frequency`` (pinion_speed) [Hz]; with ``convergence``, ``convergence_*``
-        (dimensions ``convergence_dt`` [s], ``convergence_signal``). Attributes: threshold,
-        map range, torque, dt, tolerance, the sweep's text and run statistics, the case
-        (TOML), the version, the run time.
+        ``mesh_frequency`` (pinion_speed) [Hz]; ``error`` (message of a failed run) [-]; with
+        ``convergence``, ``convergence_*`` (dimensions ``convergence_dt`` [s],
+        ``convergence_signal``); with ``runup``, ``runup_*`` (dimensions ``runup_window`` [-],
+        ``runup_signal``). Every variable and coordinate has ``units`` ("1" for dimensionless
+        numbers and labels) and ``long_name``. Attributes: threshold, map range, torque, dt,
+        tolerance, the sweep's text and run statistics, the case (TOML), the version, the run
+        time.
     """
     from .._optional import require_extra
 
@@ -739,9 +744,10 @@ def _result(raw, sw):
         "units": "1", "long_name": "largest RMS(model II - model I-static) / STD(model II) over "
                                    + ", ".join(MAIN_SIGNALS)})
     out["error"] = (dims, np.asarray(ds["error"].values).astype(str),
-                    {"long_name": "message of a run the sweep recorded as failed"})
+                    {"units": "1", "long_name": "message of a run the sweep recorded as failed "
+                                                "(empty when it did not fail)"})
     out = out.assign_coords(signal=("signal", list(SIGNALS),
-                                    {"long_name": "compared record variable"}))
+                                    {"units": "1", "long_name": "compared record variable"}))
     w = out["pinion_speed"].values
     out = out.assign_coords(mesh_frequency=("pinion_speed", w * int(base.pinion.teeth)
                                             / (2 * np.pi),
@@ -787,6 +793,9 @@ def _with_convergence(ds, base, progress):
     ds.attrs["convergence_status"] = "ok"
     ds.attrs["convergence_reference"] = conv.attrs["reference"]
     conv = conv.rename({"dt": "convergence_dt", "signal": "convergence_signal"})
+    conv = conv.assign_coords(convergence_signal=(
+        "convergence_signal", conv["convergence_signal"].values,
+        {"units": "1", "long_name": "record variable compared in the time-step check"}))
     for name in conv.data_vars:
         ds[f"convergence_{name}"] = conv[name]
     return ds
@@ -809,6 +818,12 @@ def _with_runup(ds, base, progress):
         if key != "title":
             ds.attrs[f"runup_{key}"] = val
     ru = ru.rename({"window": "runup_window", "signal": "runup_signal"})
+    ru = ru.assign_coords(
+        runup_window=("runup_window", ru["runup_window"].values, {
+            "units": "1", "long_name": "index of the run-up window (equal shares of the record, "
+                                       "in time order)"}),
+        runup_signal=("runup_signal", ru["runup_signal"].values, {
+            "units": "1", "long_name": "record variable compared in the run-up"}))
     for name in ru.data_vars:
         ds[f"runup_{name}"] = ru[name]
     return ds

@@ -505,7 +505,7 @@ def write_report(ds, out, *, command: str = "") -> Path:
         lo, hi = s["above_stiffness"]
         rep.paragraph(
             f"All {s['above']} points above {100 * s['threshold']:g} % have bearing stiffness "
-            f"{lo:.3g}..{hi:.3g} N/m and a mesh frequency whose harmonic n = "
+            f"{_span((lo, hi), '.3g')} N/m and a mesh frequency whose harmonic n = "
             f"{', '.join(str(n) for n in ns)} lies within {100 * d:.3g} % of the linear "
             "centre-distance mode (the bearing mode in which the gear centres move against "
             "each other). Elsewhere in the range, model I-static (the static operating centre "
@@ -583,7 +583,7 @@ def write_report(ds, out, *, command: str = "") -> Path:
     if sv:
         rep.paragraph(
             f"RMS(II predictor - II start-of-step)/STD(II), largest over the main signals: "
-            f"median {sv['median']:.3g}, range {sv['min']:.3g}..{sv['max']:.3g}; it exceeds "
+            f"median {sv['median']:.3g}, range {_span((sv['min'], sv['max']), '.3g')}; it exceeds "
             f"the model II - I-static ratio at {sv['exceeds_model_difference']} of "
             f"{sv['points']} points. The time-step check below says which of the two "
             "evaluations is nearer the converged model II.")
