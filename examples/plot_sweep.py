@@ -28,7 +28,6 @@ def main(argv: list[str] | None = None):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     import numpy as np
-    import xarray as xr
 
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("store", type=Path, help="the sweep's Zarr store")
@@ -38,7 +37,13 @@ def main(argv: list[str] | None = None):
     ap.add_argument("--out", type=Path, default=None, help="PNG file (default: beside the store)")
     args = ap.parse_args(argv)
 
-    ds = xr.open_zarr(args.store)
+    from geardyn.errors import GeardynError
+    from geardyn.studies.sweep import open_sweep
+
+    try:  # a missing or damaged store is a message, not zarr's traceback
+        ds = open_sweep(args.store)
+    except GeardynError as exc:
+        sys.exit(f"{exc}")
     if args.metric not in ds:
         pairs = [str(v).split("__", 1) for v in ds.data_vars if "__" in str(v)]
         sim = sorted(f"sim__{m}" for s, m in pairs if s == "sim")

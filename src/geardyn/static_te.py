@@ -142,7 +142,8 @@ def static_transmission_error(stiffness_map, torque: float, *,
             and stiffness_map.covers(centre_distance_change)):
         raise InputError("centre_distance_change", centre_distance_change,
                          f"a value in the map's range [{stiffness_map.dd[0]:.6g}, "
-                         f"{stiffness_map.dd[-1]:.6g}] m")
+                         f"{stiffness_map.dd[-1]:.6g}] m (the case's "
+                         f"stiffness.centre_distance_min and _max)")
     mods = modifications
     pair = mods.pair
     rb1 = pair.pinion.base_radius
@@ -247,7 +248,11 @@ def static_te_curves(case, torque: float | None = None, *, cracked: bool = False
         "title": "static transmission error, unloaded and loaded (rigid single-flank tester)",
         "case": case.name, "case_toml": case_to_toml(case),
         "stiffness_method": str(stiffness_map.attrs.get("method", case.stiffness.method)),
-        "stiffness_cracked": int(bool(cracked)), "tooth_errors_included": int(bool(errors)),
+        "stiffness_cracked": int(bool(cracked)),
+        # 1 where the curves hold tooth errors: asked for (errors) and the case has some (the
+        # healthy default said 1 while the case had none, a user audit of 2026-11-27)
+        "tooth_errors_included": int(bool(errors)
+                                     and ToothModifications.from_case(case).active),
         "geardyn_version": __version__})
     for k in ("torque", "torque_units", "mesh_force", "mesh_force_units"):
         ds.attrs.pop(k, None)

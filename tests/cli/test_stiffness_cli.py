@@ -30,6 +30,12 @@ def test_stiffness_writes_maps_and_figures(tmp_path):
                  "fig5_load_sharing.png", "fig6_crack.png"):
         assert (out / name).stat().st_size > 1000, name
     assert "mean K_t" in r.stdout and "+1.00" in r.stdout
+    assert "interpolated" not in r.stdout  # 0, 0.5 and 1 mm are on the 6-point grid
+    # on a 3-point grid (-0.5, 0.75, 2 mm) the rows at 0, 0.5 and 1 mm are interpolated: marked
+    r3 = run("stiffness", "--out", str(tmp_path / "out3"), *SMALL, "--set",
+             "stiffness.centre_distances=3", cache=tmp_path / "c")
+    assert r3.returncode == 0, r3.stderr
+    assert r3.stdout.count(" * │") == 6 and "interpolated in the map" in r3.stdout, r3.stdout
     # map notes come once each as "note: ..." lines, never as Python's path-and-code warnings
     notes = [ln for ln in r.stderr.splitlines() if ln.startswith("note:")]
     assert len(notes) == len(set(notes)) and ".py:" not in r.stderr

@@ -82,3 +82,34 @@ def test_check_case_names_the_field():
     with pytest.raises(InputError) as exc:
         check_case(paper_case(['crack.depth="50 mm"']))
     assert exc.value.field == "crack.depth"
+
+
+def test_a_fault_that_does_not_fit_is_shown_and_its_value_named_as_written():
+    """``config show`` shows a case it would refuse, a fault that does not fit its tooth
+    included (it exited 2 with no output, a user audit of 2026-11-27), and ``config validate``
+    names the value as written with its SI value beside."""
+    from pathlib import Path
+
+    spall = str(Path(__file__).resolve().parents[2] / "examples" / "faults" / "spall.toml")
+    r = cli("config", "show", "--config", spall, "--set", 'faults.0.width="30 mm"')
+    assert r.exit_code == 0, r.output
+    assert tomllib.loads(r.stdout)["faults"]["value"][0]["width"] == "30 mm"
+    assert "note: this case does not pass 'geardyn config validate': faults[0].width: got " \
+           "'30 mm (= 0.03 m)'" in r.stderr.replace("\n", " "), r.stderr
+    r = cli("config", "validate", spall, "--set", 'faults.0.width="30 mm"')
+    assert_clean_error(r, "faults[0].width")
+    assert "got '30 mm (= 0.03 m)'" in r.stderr, r.stderr
+
+
+def test_show_prints_faults_as_written_and_loads_back(tmp_path):
+    """``[[faults]]`` values as the file wrote them ("3 deg", not 0.05235987755982989), and the
+    printed case loads back to the same faults."""
+    from pathlib import Path
+
+    two = Path(__file__).resolve().parents[2] / "examples" / "faults" / "two_faults.toml"
+    r = cli("config", "show", "--config", str(two))
+    assert r.exit_code == 0, r.output
+    spall = tomllib.loads(r.stdout)["faults"]["value"][0]
+    assert spall["roll_length"] == "3 deg" and spall["depth"] == "0.1 mm", spall
+    shown = _case(tmp_path, r.stdout, "shown.toml")
+    assert load_case(shown).faults == load_case(two).faults

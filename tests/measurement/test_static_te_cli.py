@@ -49,9 +49,27 @@ def test_static_te_writes_units_and_the_perfect_pair_oracle(tmp_path):
 @pytest.mark.parametrize("args,field", [
     (["--torque", "-5"], "--torque"), (["--torque", "5 m"], "--torque"),
     (["--points", "3"], "--points"), (["--stiffness", "abc"], "--stiffness"),
-    (["--dd", "1 s"], "--centre-distance-change")])
+    (["--dd", "1 s"], "--centre-distance-change"),
+    # beyond the map's range (within the contact-ratio limit): named before the map is built
+    (["--dd", "3 mm"], "--centre-distance-change: got '3 mm'; allowed: a change within the "
+                       "stiffness map's range [-0.5, 2] mm")])
 def test_static_te_bad_input_names_the_field(tmp_path, args, field):
     r = CliRunner().invoke(app, ["static-te", "--out", str(tmp_path / "x.nc"), *args])
     assert r.exit_code == 2, r.output
     assert field in r.output and "Traceback" not in r.output
     assert not (tmp_path / "x.nc").exists()
+
+
+def test_tooth_errors_included_says_whether_the_curves_hold_any():
+    """1 only where errors were asked for and the case has some (the healthy paper case said 1
+    beside ``tooth_errors: 0``, a user audit of 2026-11-27)."""
+    import geardyn
+    from geardyn.static_te import static_te_curves
+
+    small = {"stiffness.method": "pem", "stiffness.centre_distances": 3,
+             "stiffness.nodes_per_segment": 6}
+    plain = geardyn.paper_case(small)
+    graded = geardyn.paper_case({**small, "modifications.pinion.grade": 6})
+    assert static_te_curves(plain, n=64).attrs["tooth_errors_included"] == 0
+    assert static_te_curves(graded, n=64).attrs["tooth_errors_included"] == 1
+    assert static_te_curves(graded, n=64, errors=False).attrs["tooth_errors_included"] == 0

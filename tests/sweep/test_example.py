@@ -155,3 +155,11 @@ def test_plot_sweep_single_axis_default_and_text_axis(tmp_path, client):
     ax = fig.axes[0]
     assert [t.get_text() for t in ax.get_xticklabels()] == ["II", "I-static"]
     assert ax.get_xlabel() == "simulation.model"
+
+
+def test_plot_sweep_of_a_missing_store_is_a_message(tmp_path):
+    """Not zarr's FileNotFoundError traceback (a user audit of 2026-11-27)."""
+    main = runpy.run_path(str(SCRIPT))["main"]
+    with pytest.raises(SystemExit) as info:
+        main([str(tmp_path / "nowhere.zarr")])
+    assert str(info.value).endswith("nowhere.zarr: is not a Zarr store"), info.value

@@ -1,4 +1,4 @@
-"""``geardyn config``: show, validate and describe case files."""
+"""``geardyn config``: show and validate case files, and print their schema."""
 
 from __future__ import annotations
 
@@ -11,7 +11,9 @@ from rich.markup import escape
 from . import app
 from ._common import ConfigOption, SetOption, console, err_console, handle_errors
 
-config_app = typer.Typer(help="Show, validate and describe case files.", no_args_is_help=True)
+config_app = typer.Typer(help="Show and validate case files (config show, config validate FILE), "
+                              "and print their JSON schema (config schema).",
+                         no_args_is_help=True)
 app.add_typer(config_app, name="config")
 
 
@@ -26,9 +28,14 @@ def show(config: ConfigOption = None, set_: SetOption = None) -> None:
     from ..errors import InputError
     from ._common import one_line
 
-    details = load_case_details(config, set_ or [])
+    # a fault that does not fit its tooth is shown too (the case is read to be mended)
+    details = load_case_details(config, set_ or [], faults_checked=False)
     typer.echo(case_to_display_toml(details), nl=False)
     try:  # shown to be read, not run: say what the commands that run it would refuse
+        if details.case.faults:
+            from ..faults import check_faults
+
+            check_faults(details.case)
         check_case(details.case)
     except InputError as exc:
         err_console.print(f"[yellow]note[/yellow]: this case does not pass 'geardyn config "
@@ -61,12 +68,16 @@ def validate(file: Annotated[Path, typer.Argument(help="Case file (TOML) to chec
     from ..errors import InputError
 
     try:
-        details = load_case_details(file, set_ or [])
+        details = load_case_details(file, set_ or [], faults_checked=False)
     except InputError as exc:
         _say_if_sweep_file(file, exc)
         raise
     case = details.case
     try:
+        if case.faults:  # here, so that the error shows the value as written ("30 mm")
+            from ..faults import check_faults
+
+            check_faults(case)
         notes = check_case(case)
     except InputError as exc:
         raise with_written_value(exc, details) from None

@@ -85,6 +85,12 @@ def static_te(
     from .geometry import operating_summary
 
     operating_summary(case.gear_pair(), dd)  # the teeth apart and in mesh, as geometry checks
+    lo, hi = case.stiffness.centre_distance_min, case.stiffness.centre_distance_max
+    if not lo <= dd <= hi:  # before the map is built: it covers [lo, hi] only
+        raise InputError("--centre-distance-change", centre_distance_change,
+                         f"a change within the stiffness map's range [{lo * 1e3:.6g}, "
+                         f"{hi * 1e3:.6g}] mm, or a wider map (--set "
+                         f"stiffness.centre_distance_{'max' if dd > hi else 'min'}=...)")
     from ..faults import faults_from_case
 
     faults = [f for f in faults_from_case(case) if not f.is_null()]

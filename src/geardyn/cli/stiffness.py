@@ -147,13 +147,20 @@ def stiffness(
                 "max K_t [N m/rad]", "mean k_mb [N/m]"):
         t.add_column(col, justify="right")
     th = np.linspace(0.0, maps["healthy"].period, 4096, endpoint=False)
+    between = False
     for name, m in maps.items():
         shown = [d for d in (m.dd[0], 0.0, 0.5e-3, 1.0e-3, m.dd[-1]) if m.covers(d)]
         for d in sorted(set(round(x, 12) for x in shown)):
             kt = m.torsional(th, d)
             eps = pair.operating(d, check=False).contact_ratio
-            t.add_row(name, f"{d * 1e3:+.2f}", f"{eps:.4f}", f"{kt.mean():.4g}",
-                      f"{kt.min():.4g}", f"{kt.max():.4g}", f"{m(th, d).mean():.4g}")
+            # a centre distance between the map's own ones is interpolated: marked, not hidden
+            on_grid = bool(np.any(np.isclose(np.asarray(m.dd, float), d, rtol=0, atol=1e-12)))
+            between |= not on_grid
+            t.add_row(name, f"{d * 1e3:+.2f}" + ("" if on_grid else " *"), f"{eps:.4f}",
+                      f"{kt.mean():.4g}", f"{kt.min():.4g}", f"{kt.max():.4g}",
+                      f"{m(th, d).mean():.4g}")
+    if between:
+        t.caption = "* between the map's centre distances: interpolated in the map"
     console.print(t)
     notes = sorted({w for m in maps.values() for w in _map_warnings(m)})
     for w in notes:

@@ -18,7 +18,7 @@ from typing import Annotated
 import typer
 
 from . import app
-from ._common import ConfigOption, SetOption, console, err_console, handle_errors, progress_bar
+from ._common import SetOption, console, err_console, handle_errors, progress_bar
 
 
 def _load_evaluator(spec: str):
@@ -115,7 +115,10 @@ def sweep(
         "--evaluator", help="Advanced: module:attribute of a custom Evaluator computing each run "
                             "instead of geardyn's simulation + diagnostics.",
         show_default=False)] = None,
-    config: ConfigOption = None,
+    config: Annotated[Path | None, typer.Option(
+        "--config", "-c", help="Case file (TOML) replacing the sweep file's base case (its "
+                               "'base', else the paper's case); the sweep's [set] still "
+                               "applies.", show_default=False)] = None,
     set_: SetOption = None,
 ) -> None:
     """Run the sweep in SWEEP_FILE on Dask into the Zarr store OUT (resumable: re-run the same

@@ -23,7 +23,7 @@ from pydantic import (
 
 from ..errors import DataFileError, InputError
 from ..units import DIMENSIONS, format_si
-from .models import _CONTROL, Case, _field_dimension, check_text
+from .models import _CONTROL, Case, _dimension_of, _field_dimension, check_text
 
 PAPER_CASE = "xue_howard"
 
@@ -520,13 +520,14 @@ def _model_leaves(model: BaseModel, prefix: str = "") -> Iterator[tuple[str, Any
             yield key, value
 
 
-def _validate(data: dict[str, Any], source: str = "") -> Case:
-    """Validate plain case data, naming the first bad field as the user wrote it."""
+def _validate(data: dict[str, Any], source: str = "", *, faults_checked: bool = True) -> Case:
+    """Validate plain case data, naming the first bad field as the user wrote it
+    (``faults_checked=False``: the faults' geometry checks left to the caller)."""
     try:
         case = Case.model_validate(data)
     except ValidationError as exc:
         raise _format_validation_error(exc, data) from None
-    if case.faults:  # geometry checks of the faults list (errors name faults[i].<key>)
+    if case.faults and faults_checked:  # the faults' geometry (errors name faults[i].<key>)
         from ..faults import check_faults
 
         check_faults(case)
@@ -553,8 +554,11 @@ class CaseDetails:
 
 def load_case_details(path: str | Path | None = None,
                       overrides: Iterable[str] | Mapping[str, Any] = (), *,
-                      override_source: str = SET_SOURCE) -> CaseDetails:
-    """:func:`load_case` keeping the values as written and where each came from."""
+                      override_source: str = SET_SOURCE,
+                      faults_checked: bool = True) -> CaseDetails:
+    """:func:`load_case` keeping the values as written and where each came from
+    (``faults_checked=False``: without the faults' geometry checks, for ``geardyn config show``,
+    which shows a case it would refuse; :func:`geardyn.faults.check_faults` runs them)."""
     if path is not None and not isinstance(path, str | os.PathLike):
         raise InputError("path", path, "a case file path (str or pathlib.Path), or None for the "
                                        "paper's case")
@@ -574,7 +578,7 @@ def load_case_details(path: str | Path | None = None,
         prov[key] = override_source
         origin[key] = override_source
     data["provenance"] = prov
-    case = _validate(data)
+    case = _validate(data, faults_checked=faults_checked)
     changed = _changed_keys(before, case, [k for k in ov if k not in _UNSOURCED])
     if changed and "name" not in ov:  # no longer the named case: say so
         data["name"] = f"{data.get('name', 'case')} (modified)"
@@ -582,7 +586,7 @@ def load_case_details(path: str | Path | None = None,
             keys = ", ".join(changed[:6]) + (", ..." if len(changed) > 6 else "")
             data["description"] = f"{data.get('description', '')} [changed by {override_source}: " \
                                   f"{keys}]".strip()
-        case = _validate(data)
+        case = _validate(data, faults_checked=faults_checked)
     origin = {**{k: "default" for k, _ in _model_leaves(case) if k not in _UNSOURCED}, **origin}
     written = {k: v for k, v in data.items() if k != "provenance"}
     return CaseDetails(case=case, written=written, origin=origin)
@@ -641,8 +645,16 @@ def _changed_keys(before: dict[str, Any], case: Case, keys: list[str]) -> list[s
 def with_written_value(exc: InputError, details: CaseDetails) -> InputError:
     """``exc`` with its value as the user wrote it when that was a quantity with a unit, the SI
     value beside (``crack.depth: got '50 mm (= 0.05 m)'``); else ``exc`` itself."""
-    dim = _field_dimension(exc.field) if isinstance(exc.field, str) else None
-    written = _raw_value(details.written, tuple(exc.field.split(".")), None) if dim else None
+    if not isinstance(exc.field, str):
+        return exc
+    key = re.sub(r"\[(\d+)\]", r".\1", exc.field)  # faults[0].width -> faults.0.width
+    parts = tuple(int(p) if p.isdigit() else p for p in key.split("."))
+    dim = _field_dimension(key)
+    faults = details.case.faults
+    if (dim is None and len(parts) == 3 and parts[0] == "faults" and isinstance(parts[1], int)
+            and parts[1] < len(faults) and parts[2] in type(faults[parts[1]]).model_fields):
+        dim = _dimension_of(type(faults[parts[1]]), parts[2])  # the fault type's own field
+    written = _raw_value(details.written, parts, None) if dim else None
     if not isinstance(written, str) or isinstance(exc.value, bool) \
             or not isinstance(exc.value, int | float):
         return exc

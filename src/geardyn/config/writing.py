@@ -87,6 +87,9 @@ def case_to_display_toml(details: CaseDetails) -> str:
                 note = hz_note(written) if dim == "angular velocity" else None
                 entry["si"] = f"{float(value):.10g} {DIMENSIONS[dim].si_unit}" + \
                     (f" ({note})" if note else "")
+        elif key == "faults" and isinstance(value, list):  # [[faults]]: each value as written
+            shown = [_as_written(item, written[i] if isinstance(written, list)
+                                 and i < len(written) else None) for i, item in enumerate(value)]
         entry = {"value": shown, **entry, "source": case.provenance.get(key, DEFAULT_SOURCE),
                  "origin": origin.get(key, "default")}
         node = tree
@@ -95,6 +98,16 @@ def case_to_display_toml(details: CaseDetails) -> str:
             node = node.setdefault(p, {})
         node[parts[-1]] = entry
     return _dumps(tree)
+
+
+def _as_written(item: dict[str, Any], written: Any) -> dict[str, Any]:
+    """A ``[[faults]]`` entry (SI values) with each quantity as the case file or ``--set``
+    wrote it (``"3 deg"``, not ``0.05235987755982989``); it validated to the SI value, so the
+    entry loads back to the same fault."""
+    if not isinstance(written, dict):
+        return item
+    return {k: written[k] if isinstance(written.get(k), str) and not isinstance(v, str) else v
+            for k, v in item.items()}
 
 
 #: Keys of a ``{ value = ..., source = ... }`` table, as the JSON schema describes them.
