@@ -103,7 +103,8 @@ def test_case_crack_refusals():
     (["--paris-c", "1e-11 m/cycle/(MPa m^0.5)^m"], "--paris-m"),
     (["--paris-c", "1e-11", "--paris-m", "3"], "--paris-c"),
     ([*PARIS, "--set", "faults.0.depth=20mm"], "faults[0].depth"),
-    ([*PARIS, "--step-size", "5 mm"], "--step-size"),
+    ([*PARIS, "--step-size", "5 mm"], "--step-size: got '5 mm'; allowed: a crack extension in "
+                                      "(0, "),
     ([*PARIS, "--stiffness", "iso"], "--stiffness"),
 ])
 def test_bad_input_is_one_line_exit_2(tmp_path, args, field):

@@ -37,6 +37,11 @@ def test_measure_writes_three_formats_and_diagnose_reads_them(tmp_path):
         assert ds.sizes["time"] == 12_500 and ds.attrs["fs"] == 50_000.0
         assert ds.attrs["simulation_model"] == "I" and ds.attrs["stiffness_cracked"] == 0
         assert set(ds.data_vars) == {"acc", "acc_g", "tach"}
+        # every numeric attribute with its unit beside it, as fs (a user audit, 2026-11-27)
+        assert ds.attrs["noise_rms_units"] == "m/s^2" and ds.attrs["snr_requested_units"] == "dB"
+        for k in ("lead_in", "tail", "tach_jitter", "start_time_in_simulation"):
+            assert ds.attrs[f"{k}_units"] == "s", k
+        assert ds.attrs["input_sample_rate_units"] == "Hz"
     kurt = {}
     for name, extra in (("rec.nc", []), ("rec.csv", ["--fs", "50000"]), ("rec.mat", [])):
         d = tmp_path / f"diag-{name}"

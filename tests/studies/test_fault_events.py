@@ -138,3 +138,20 @@ def test_the_caption_says_when_the_figures_are_not_centred_on_an_event():
     gear = fault_event_words({"fault_event_angle_deg": 12.34, "fault_event_period_deg": 446.4},
                              True, "cracked", "crack")
     assert "crack event" in gear and "12.3 deg" in gear and "every 446.4 deg" in gear
+
+
+def test_the_caption_says_at_which_centre_distance_the_event_angle_is():
+    """The dashed events are where the map drops most at the design centre distance; the
+    caption says so, and gives the angle at the static operating one where it differs (175.3
+    against 178.1 deg for the paper's crack with PEM: a user audit of 2026-11-27 found the
+    caption silent on it)."""
+    from geardyn.studies.paper_report import fault_event_words
+
+    s = {"fault_event_angle_deg": 175.34, "fault_event_period_deg": 360.0,
+         "crack_angle_in_stiffness_deg": 178.07}
+    words = fault_event_words(s, True, "cracked", "crack")
+    assert "175.3 deg, where the cracked map falls furthest below the healthy one at the " \
+           "design centre distance; at the static operating centre distance, 178.1 deg" in words
+    same = fault_event_words({**s, "crack_angle_in_stiffness_deg": 175.34}, True, "cracked",
+                             "crack")
+    assert "static operating" not in same and "every 360.0 deg" in same

@@ -9,6 +9,7 @@ exits with 130 (see :func:`_say_interrupted`); nothing prints a traceback unless
 from __future__ import annotations
 
 import contextlib
+import errno
 import functools
 import os
 import sys
@@ -178,6 +179,11 @@ def _say_interrupted() -> None:
     raise typer.Exit(130) from None
 
 
+#: ``errno`` values of a full disk or an exhausted quota.
+_FULL_DISK = frozenset(getattr(errno, name) for name in ("ENOSPC", "EDQUOT")
+                       if hasattr(errno, name))
+
+
 def handle_errors(fn: F) -> F:
     """Turn geardyn errors into one clear line and exit code 2 (130 on Ctrl-C)."""
 
@@ -206,6 +212,17 @@ def handle_errors(fn: F) -> F:
             _INTERRUPT["redeliver"] = False  # raised: a delivery still due would raise it again
             _say_interrupted()
         except Exception as exc:  # a bug: say so briefly, keep the traceback for GEARDYN_DEBUG
+            if (isinstance(exc, OSError) and exc.errno in _FULL_DISK
+                    and not os.environ.get("GEARDYN_DEBUG")):
+                # the machine's, not geardyn's (it read "a bug in geardyn", a user audit of
+                # 2026-11-27); every output is written to a temporary file first: none is torn
+                where = f" (writing {exc.filename})" if exc.filename else ""
+                err_console.print(f"[bold red]error:[/bold red] "
+                                  f"{escape(one_line((exc.strerror or str(exc)) + where))}: free "
+                                  "some space (geardyn's cache: 'geardyn cache info', 'geardyn "
+                                  "cache clear') and run the same command again",
+                                  highlight=False, soft_wrap=True)
+                raise typer.Exit(1) from None
             if _INTERRUPT["pending"]:
                 _INTERRUPT["redeliver"] = False
                 # a Ctrl-C that landed inside an import which was failing anyway comes out as

@@ -143,9 +143,10 @@ def crack_growth(
                         "earlier when the tip comes within one step of the outline.",
         show_default=False)] = None,
     step_size: Annotated[str | None, typer.Option(
-        "--step-size", help="Crack extension per step, a length such as '1 mm' (default: "
-                            "module/6, --quick module/4, at most 3.9 times the initial crack "
-                            "depth).", show_default=False)] = None,
+        "--step-size", help="Crack extension per step, a length such as '1 mm', below four "
+                            "times the initial crack length (default: module/6, --quick "
+                            "module/4, at most 3.9 times the initial crack length).",
+        show_default=False)] = None,
     points: Annotated[int | None, typer.Option(
         "--points", help="Crack lengths simulated for the indicators (default 5, --quick 3).",
         show_default=False)] = None,
@@ -217,7 +218,12 @@ def crack_growth(
         step = min(step, 3.9 * crack.depth)
     else:
         step = to_si(step_size, "length", "--step-size")
-    check_step(step, crack.depth, "--step-size")
+    try:
+        check_step(step, crack.depth, "--step-size")
+    except InputError as exc:  # the value as written ("30 mm"), the bound in mm
+        raise InputError(exc.field, step_size if step_size is not None else exc.value,
+                         f"a crack extension in (0, {4e3 * crack.depth:.6g}) mm: below four "
+                         f"times the initial crack length, {1e3 * crack.depth:.6g} mm") from None
     n_steps = steps if steps is not None else (QUICK["steps"] if quick else 60)
     n_points = points if points is not None else (QUICK["points"] if quick else 5)
     settle = QUICK["settle_time"] if quick else None

@@ -37,6 +37,14 @@ CHANNELS = {
 }
 
 
+#: Units of the record's numeric attributes, written beside each as ``<name>_units`` (a user
+#: audit of 2026-11-27 found only ``fs`` with its unit).
+ATTRIBUTE_UNITS = {"input_sample_rate": "Hz", "lead_in": "s", "tail": "s", "noise_rms": "m/s^2",
+                   "clipped_samples": "1", "clipped_fraction": "1", "snr_requested": "dB",
+                   "accelerometer_resonance": "Hz", "tach_jitter": "s",
+                   "start_time_in_simulation": "s", "sample_rate": "Hz"}
+
+
 def to_dataset(m: Measured, attrs: dict | None = None):
     """An xarray Dataset of a measurement (layout in the module docstring).
 
@@ -59,6 +67,9 @@ def to_dataset(m: Measured, attrs: dict | None = None):
     for k, v in m.info.items():
         ga[k] = v if isinstance(v, str | int | float) else str(v)
     ga.update(attrs or {})
+    for key, unit in ATTRIBUTE_UNITS.items():  # as "fs_units": every number with its unit
+        if isinstance(ga.get(key), int | float) and not isinstance(ga.get(key), bool):
+            ga[f"{key}_units"] = unit
     return xr.Dataset(data, coords={"time": ("time", m.time, {"units": "s",
                                                              "long_name": "time from the "
                                                                           "first sample"})},
