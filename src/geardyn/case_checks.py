@@ -7,7 +7,9 @@
 ``measurement.fs = "10 Hz"`` and ``measurement.snr = -500`` passed validation). It adds no
 physics of its own; each check is the stage's own code:
 
-1. the gear pair (:meth:`geardyn.config.Case.gear_pair`: teeth, radii, bore, profile shift);
+1. the faults' geometry (:func:`geardyn.faults.check_faults`, as :func:`geardyn.load_case`
+   runs it) and the gear pair (:meth:`geardyn.config.Case.gear_pair`: teeth, radii, bore,
+   profile shift);
 2. the operating geometry over the stiffness map's centre-distance range
    (:meth:`geardyn.geometry.GearPair.operating`: contact ratio >= 1, centre distance above the
    base-radius sum), reported on ``stiffness.centre_distance_min``/``_max``;
@@ -91,6 +93,10 @@ def check_case(case, *, cache=None) -> list[str]:
     from .errors import GeometryError, InputError
     from .stiffness import centre_distance_grid
 
+    if case.faults:  # as load_case runs them (config show and validate load without them)
+        from .faults import check_faults
+
+        check_faults(case)
     pair = case.gear_pair()
     dd = centre_distance_grid(case)
     ends = (("stiffness.centre_distance_min", float(dd[0])),

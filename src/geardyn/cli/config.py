@@ -32,10 +32,6 @@ def show(config: ConfigOption = None, set_: SetOption = None) -> None:
     details = load_case_details(config, set_ or [], faults_checked=False)
     typer.echo(case_to_display_toml(details), nl=False)
     try:  # shown to be read, not run: say what the commands that run it would refuse
-        if details.case.faults:
-            from ..faults import check_faults
-
-            check_faults(details.case)
         check_case(details.case)
     except InputError as exc:
         err_console.print(f"[yellow]note[/yellow]: this case does not pass 'geardyn config "
@@ -73,11 +69,7 @@ def validate(file: Annotated[Path, typer.Argument(help="Case file (TOML) to chec
         _say_if_sweep_file(file, exc)
         raise
     case = details.case
-    try:
-        if case.faults:  # here, so that the error shows the value as written ("30 mm")
-            from ..faults import check_faults
-
-            check_faults(case)
+    try:  # the faults' checks here too, so that an error shows the value as written ("30 mm")
         notes = check_case(case)
     except InputError as exc:
         raise with_written_value(exc, details) from None

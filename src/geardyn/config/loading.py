@@ -23,7 +23,14 @@ from pydantic import (
 
 from ..errors import DataFileError, InputError
 from ..units import DIMENSIONS, format_si
-from .models import _CONTROL, Case, _dimension_of, _field_dimension, check_text
+from .models import (
+    _CONTROL,
+    Case,
+    _dimension_of,
+    _field_dimension,
+    _model_field,
+    check_text,
+)
 
 PAPER_CASE = "xue_howard"
 
@@ -456,21 +463,8 @@ _NUMBER_ERRORS = ("float_parsing", "int_parsing", "float_type", "int_type")
 
 def _field_description(loc: tuple) -> str:
     """The description of the case field at ``loc`` (its unit, its meaning), or ''."""
-    model: type[BaseModel] = Case
-    info = None
-    for p in loc:
-        if isinstance(p, int) or str(p).isdigit():  # an entry of a list of tables
-            continue
-        if model is None:
-            return ""
-        info = model.model_fields.get(str(p))
-        if info is None:
-            return ""
-        ann = info.annotation
-        sub = [a for a in getattr(ann, "__args__", (ann,)) if isinstance(a, type)
-               and issubclass(a, BaseModel)]
-        model = sub[0] if sub else None
-    return (info.description or "").rstrip(".") if info is not None else ""
+    found = _model_field(loc)
+    return (found[0].model_fields[found[1]].description or "").rstrip(".") if found else ""
 
 
 def _raw_value(data: Mapping[str, Any], loc: tuple, default: Any) -> Any:

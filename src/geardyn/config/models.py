@@ -674,10 +674,11 @@ def _dimension_of(model: type[BaseModel], name: str) -> str | None:
     return _dimension_in(f.annotation, f.metadata)
 
 
-def _field_dimension(key: str) -> str | None:
-    """Dimension of a dotted case key (``"pair.module"`` -> ``"length"``), else None."""
+def _model_field(parts) -> tuple[type[BaseModel], str] | None:
+    """The section model and field name a case key's parts reach (``("pair", "module")`` ->
+    ``(PairConfig, "module")``), else None (an unknown key, or one inside a list of tables)."""
     model: type[BaseModel] = Case
-    parts = key.split(".")
+    parts = [str(p) for p in parts]
     for p in parts[:-1]:
         f = model.model_fields.get(p)
         if f is None:
@@ -687,6 +688,10 @@ def _field_dimension(key: str) -> str | None:
         if not sub:
             return None
         model = sub[0]
-    if parts[-1] not in model.model_fields:
-        return None
-    return _dimension_of(model, parts[-1])
+    return (model, parts[-1]) if parts and parts[-1] in model.model_fields else None
+
+
+def _field_dimension(key: str) -> str | None:
+    """Dimension of a dotted case key (``"pair.module"`` -> ``"length"``), else None."""
+    found = _model_field(key.split("."))
+    return _dimension_of(*found) if found else None
