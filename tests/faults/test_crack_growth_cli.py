@@ -181,6 +181,23 @@ def test_example_quick_through_the_cli(tmp_path):
     er = ds["transmission_error__EnergyRatio"].values
     assert np.all(np.isfinite(er)) and er[-1] > er[0]  # a longer crack, a larger energy ratio
     assert np.all(np.diff(ds["sample_cycles"].values) > 0)
+    # NA4 over the run (healthy record first): its first record is the single record's NA4;
+    # against the residual kurtosis, which diagnostic_features computes on its own, each
+    # sample's NA4 over the run is kurtosis * (variance / mean variance so far)^2
+    for s in ("v_yg", "omega_p", "transmission_error"):
+        assert float(ds[f"{s}__NA4_run_healthy"]) == pytest.approx(
+            float(ds[f"{s}__NA4_healthy"]), rel=1e-9)
+        var = np.r_[float(ds[f"{s}__residual_variance_healthy"]),
+                    ds[f"{s}__residual_variance"].values]
+        mean_so_far = np.cumsum(var) / np.arange(1, var.size + 1)
+        want = ds[f"{s}__residual_kurtosis"].values * (var[1:] / mean_so_far[1:]) ** 2
+        np.testing.assert_allclose(ds[f"{s}__NA4_run"].values, want, rtol=1e-9)
+        # the residual's variance grows with the crack (the 1 mm crack's is the noise's, as
+        # the healthy record's), so the run's mean lags behind it and NA4 over the run stands
+        # above the single record's (the residual kurtosis) once the crack has grown
+        assert np.all(np.diff(var[1:]) > 0), (s, var)
+        assert np.all(ds[f"{s}__NA4_run"].values[1:] > ds[f"{s}__NA4"].values[1:])
+    assert ds["v_yg__residual_variance"].attrs["units"] == "(m/s)^2"
     k = ds["mesh_stiffness"].values
     assert np.all(np.isfinite(k)) and k[-1].min() < ds["healthy_mesh_stiffness"].values.min()
     # the CSV: one row per crack length, units in the header, indicators at the sampled rows

@@ -13,6 +13,19 @@ What it composes (no physics of its own):
    :func:`geardyn.studies.sweep.evaluate.diagnostic_features` (TSA against the cracked gear's
    exact angle, residual, demodulation, FM0/FM4/M6A/M8A/NA4/NB4/energy ratio)
    for each signal; and the same for the healthy pair (no faults) as the baseline.
+3. NA4 and NB4 over the run (``NA4_run``, ``NB4_run``): the records of a crack growing in one
+   gearbox are the "run" for which Zakrajsek (1993) defined NA4, so each sample's fourth moment
+   is divided by the mean variance of every record up to it, the healthy record first
+   (:func:`geardyn.diagnostics.metrics.na4` with ``history``):
+
+   .. math:: NA4_{run}(M) = \frac{m_4(r_M)}{\Bigl(\frac1M \sum_{i=1}^{M} m_2(r_i)\Bigr)^2}
+
+   with :math:`r_1` the healthy residual and :math:`r_2 .. r_M` the sampled cracks' in order of
+   growth (a sample whose simulation failed is left out of the history); NB4 the same on the
+   envelope of the band about the first mesh harmonic. The single-record ``NA4`` (M = 1) is the
+   residual's own kurtosis, so it cannot show what NA4 was made for: a residual whose variance
+   grows with the damage, which the run's average lags behind. ``residual_variance`` is each
+   record's :math:`m_2(r)`.
 
 The equivalent straight crack (an approximation, stated in the output)
 -----------------------------------------------------------------------
@@ -54,7 +67,7 @@ import numpy as np
 
 from ..errors import GeardynError, InputError
 
-__all__ = ["METRICS", "DEFAULT_SIGNALS", "EQUIVALENT_CRACK_NOTE", "sample_indices",
+__all__ = ["METRICS", "RUN_METRICS", "DEFAULT_SIGNALS", "EQUIVALENT_CRACK_NOTE", "sample_indices",
            "add_indicators", "crack_growth_study"]
 
 #: Condition metrics stored per signal: name -> long name.
@@ -67,6 +80,14 @@ METRICS = {
     "NB4": "NB4 of the envelope (single record)",
     "EnergyRatio": "energy ratio RMS(difference)/RMS(regular)",
     "residual_kurtosis": "kurtosis of the residual signal",
+}
+#: Metrics over the run (the healthy record, then the samples in order of growth): name ->
+#: long name (module docstring, item 3).
+RUN_METRICS = {
+    "NA4_run": "NA4 over the run: m4 of this record's residual / (mean residual variance of "
+               "the healthy record and the samples up to this one)^2 (Zakrajsek 1993)",
+    "NB4_run": "NB4 over the run: NA4_run of the envelope of the band about the first mesh "
+               "harmonic",
 }
 #: Simulated signals reduced to indicators (the sweep's defaults).
 DEFAULT_SIGNALS = ("v_yg", "omega_p", "transmission_error")
@@ -104,9 +125,50 @@ def _features(case, smap, signals, shaft: str, teeth: int, noise_snr_db: float |
         rng = np.random.default_rng(seed)
         scale = 10.0 ** (-float(noise_snr_db) / 20.0)
         sig = {k: v + rng.standard_normal(v.shape) * (np.std(v) * scale) for k, v in sig.items()}
-    return diagnostic_features(sig, np.asarray(ds[shaft].values, dtype=np.float64), teeth=teeth,
-                               samples_per_rev=d.samples_per_rev, harmonic=d.harmonic,
-                               bandwidth=d.bandwidth, residual_preset=d.residual_preset)
+    out = diagnostic_features(sig, np.asarray(ds[shaft].values, dtype=np.float64), teeth=teeth,
+                              samples_per_rev=d.samples_per_rev, harmonic=d.harmonic,
+                              bandwidth=d.bandwidth, residual_preset=d.residual_preset,
+                              keep_tsa=True)
+    for s in signals:
+        out[f"{s}__units"] = str(ds[s].attrs.get("units", ""))
+    return out
+
+
+def _squared_unit(unit: str) -> str:
+    """The unit of a variance of a signal in ``unit``: ``"m/s"`` -> ``"(m/s)^2"``, ``"m"`` ->
+    ``"m^2"``, ``""`` or ``"1"`` -> ``"1"``."""
+    unit = unit.strip()
+    if unit in ("", "1"):
+        return "1"
+    return f"{unit}^2" if unit.isalnum() else f"({unit})^2"
+
+
+def _run_metrics(case, tsas: list, teeth: int) -> dict[str, np.ndarray]:
+    """NA4 and NB4 over the run, and each record's residual variance (module docstring, item
+    3), from the TSAs of one signal: ``tsas[0]`` the healthy record's, then the samples' in
+    order of growth (None for a failed sample: NaN, and left out of the history).
+
+    Returns arrays over the records (healthy first): ``NA4_run``, ``NB4_run`` [-] and
+    ``residual_variance`` (the signal's unit squared).
+    """
+    from ..diagnostics.metrics import band_envelope, central_moment, na4
+    from ..diagnostics.spectra import residual
+
+    preset = case.diagnostics.residual_preset
+    out = {k: np.full(len(tsas), np.nan) for k in (*RUN_METRICS, "residual_variance")}
+    res_hist: list[np.ndarray] = []
+    env_hist: list[np.ndarray] = []
+    for j, x in enumerate(tsas):
+        if x is None:
+            continue
+        r = residual(x, teeth=teeth, preset=preset)
+        env = band_envelope(x, teeth=teeth)  # harmonic 1, band (Z-1)//2: as in NB4 itself
+        out["residual_variance"][j] = central_moment(r, 2)
+        out["NA4_run"][j] = na4(r, res_hist)
+        out["NB4_run"][j] = na4(env, env_hist)
+        res_hist.append(r)
+        env_hist.append(env)
+    return out
 
 
 def add_indicators(case, growth, *, points: int = 5, settle_time: float | None = None,
@@ -149,7 +211,9 @@ def add_indicators(case, growth, *, points: int = 5, settle_time: float | None =
         ``growth`` plus, over ``sample_length`` [m] (the sampled crack lengths):
         ``sample_cycles`` [-], ``equivalent_depth`` [m], ``equivalent_angle`` [rad],
         ``simulation_status`` (``"ok"`` or the reason of a NaN sample), ``<signal>__<metric>``
-        [-] for the metrics of :data:`METRICS`, ``mesh_stiffness`` [N/m] along ``angle`` (the
+        [-] for the metrics of :data:`METRICS` and :data:`RUN_METRICS`,
+        ``<signal>__residual_variance`` (the signal's unit squared), ``mesh_stiffness`` [N/m]
+        along ``angle`` (the
         PEM map at the design centre distance over its period); the healthy baseline as
         ``<signal>__<metric>_healthy`` and ``healthy_mesh_stiffness``.
     """
@@ -178,6 +242,7 @@ def add_indicators(case, growth, *, points: int = 5, settle_time: float | None =
         raise InputError("noise_snr_db", noise_snr_db, "a finite signal-to-noise ratio in dB, or "
                                                        "None for no noise")
     healthy = _features(base, healthy_map, signals, shaft, teeth, noise_snr_db, seed)
+    tsas = {s: [healthy[f"{s}__tsa"]] for s in signals}  # the run: healthy, then the samples
     if progress is not None:
         progress(1, total)
     mouth = (float(growth["path_x"].values[0]), float(growth["path_y"].values[0]))
@@ -209,9 +274,14 @@ def add_indicators(case, growth, *, points: int = 5, settle_time: float | None =
             f = _features(cs, smap, signals, shaft, teeth, noise_snr_db, seed + j + 1)
             for key in values:
                 values[key][j] = float(f[key])
+            for s in signals:
+                tsas[s].append(f[f"{s}__tsa"])
             status.append("ok")
         except GeardynError as exc:
             status.append(" ".join(str(exc).split())[:300])
+            for s in signals:
+                if len(tsas[s]) < j + 2:
+                    tsas[s].append(None)
         k_rows.append(row)
         if progress is not None:
             progress(j + 2, total)
@@ -246,6 +316,15 @@ def add_indicators(case, growth, *, points: int = 5, settle_time: float | None =
                                                          "long_name": f"{long} of {s}"})
             data[f"{s}__{m}_healthy"] = ((), float(healthy[f"{s}__{m}"]), {
                 "units": "1", "long_name": f"{long} of {s}, healthy pair (no faults)"})
+        run = _run_metrics(base, tsas[s], teeth)
+        unit = _squared_unit(healthy[f"{s}__units"])
+        for m, long in {**RUN_METRICS, "residual_variance": "variance m2 of the residual"
+                        }.items():
+            u = unit if m == "residual_variance" else "1"
+            data[f"{s}__{m}"] = (S, run[m][1:], {"units": u, "long_name": f"{long} of {s}"})
+            data[f"{s}__{m}_healthy"] = ((), float(run[m][0]), {
+                "units": u, "long_name": f"{long} of {s}, healthy pair (no faults: the run's "
+                                         "first record)"})
     ind = xr.Dataset(data, coords={
         S: (S, np.asarray(lengths, float), {"units": "m", "long_name": "sampled crack length "
                                                                        "along the path"}),

@@ -91,9 +91,16 @@ def fig_cycles(ds):
     return fig
 
 
-def fig_indicators(ds, metrics=("FM4", "NA4", "EnergyRatio"), signals=None):
+#: Axis labels of the metrics over the run (:data:`geardyn.studies.crack_growth.RUN_METRICS`).
+_LABELS = {"NA4_run": "NA4 over the run", "NB4_run": "NB4 over the run"}
+
+
+def fig_indicators(ds, metrics=("FM4", "NA4_run", "EnergyRatio"), signals=None):
     """Condition metrics against load cycles at the sampled crack lengths, each signal a line,
-    its healthy baseline dashed."""
+    its healthy baseline dashed. NA4 is the one over the run (the healthy record, then the
+    samples: :mod:`geardyn.studies.crack_growth`, item 3), not the single record's (which is
+    the residual's kurtosis). A panel whose values span more than a factor 30, all positive,
+    has a logarithmic axis."""
     if signals is None:
         signals = [s.strip() for s in str(ds.attrs.get("indicator_signals", "")).split(",")
                    if s.strip()]
@@ -101,13 +108,20 @@ def fig_indicators(ds, metrics=("FM4", "NA4", "EnergyRatio"), signals=None):
     axes = np.atleast_1d(fig.subplots(len(metrics), 1, sharex=True))
     n = ds["sample_cycles"].values
     for ax, m in zip(axes, metrics, strict=True):
+        seen: list[float] = []
         for i, s in enumerate(signals):
             key = f"{s}__{m}"
             if key not in ds:
                 continue
             ax.plot(n, ds[key].values, "-o", ms=4, color=f"C{i}", label=s)
-            ax.axhline(float(ds[f"{key}_healthy"].values), color=f"C{i}", ls="--", lw=0.8)
-        ax.set_ylabel(m)
+            base = float(ds[f"{key}_healthy"].values)
+            ax.axhline(base, color=f"C{i}", ls="--", lw=0.8)
+            seen += [base, *np.asarray(ds[key].values, float)]
+        v = np.asarray(seen, float)
+        v = v[np.isfinite(v)]
+        if v.size and v.min() > 0 and v.max() > 30 * v.min():
+            ax.set_yscale("log")
+        ax.set_ylabel(_LABELS.get(m, m))
         ax.grid(True, alpha=0.3)
     axes[0].set_title("Indicators against load cycles (dashed: healthy pair; "
                       f"{_stiffness_label(ds)})", fontsize="medium")
