@@ -113,3 +113,29 @@ def test_show_prints_faults_as_written_and_loads_back(tmp_path):
     assert spall["roll_length"] == "3 deg" and spall["depth"] == "0.1 mm", spall
     shown = _case(tmp_path, r.stdout, "shown.toml")
     assert load_case(shown).faults == load_case(two).faults
+
+
+def test_every_command_names_a_faults_value_as_written_and_its_entry_one_way():
+    """The commands that run a case (``load_case``, ``simulate``) name a fault's bad value as
+    written with its SI value beside, as ``config validate`` does (they echoed the SI value
+    alone: ``faults[0].angle: got 1.7453292519943295``), and the type checks name the entry as
+    the faults' own checks do (``faults[0].front``, not ``faults.0.front``)."""
+    from pathlib import Path
+
+    growth = Path(__file__).resolve().parents[2] / "examples" / "faults" / "crack_growth.toml"
+    with pytest.raises(InputError) as err:
+        load_case(growth, ['faults.0.angle="100 deg"'])
+    assert err.value.field == "faults[0].angle"
+    assert err.value.value == f"100 deg (= {math.radians(100)!r} rad)"
+    r = cli("simulate", "--config", str(growth), "--set", 'faults.0.depth="-1 mm"', "--out",
+            "never.nc")
+    assert_clean_error(r, "faults[0].depth")
+    assert "got '-1 mm (= -0.001 m)'" in r.stderr, r.stderr
+    for key, value, allowed in (("front", "wavy", "'uniform', 'linear' or 'parabolic'"),
+                                ("colour", "red", "a known key")):
+        with pytest.raises(InputError) as err:
+            load_case(growth, [f'faults.0.{key}="{value}"'])
+        assert err.value.field == f"faults[0].{key}", err.value
+        assert err.value.allowed.startswith(allowed), err.value
+    with pytest.raises(InputError, match=r"Allowed keys in faults\[0\]: angle,"):
+        load_case(growth, ['faults.0.colour="red"'])

@@ -437,9 +437,9 @@ def _format_validation_error(exc: ValidationError, data: Mapping[str, Any]) -> I
     if isinstance(problem, FieldProblem):  # a section's validator naming one of its fields
         where = (*where, problem.field)
         first = {**first, "loc": where, "input": _raw_value(data, where, None)}
-    loc = ".".join(str(p) for p in where)
+    loc = _dotted(where)
     if first["type"] == "extra_forbidden":
-        parent = ".".join(str(p) for p in first["loc"][:-1])
+        parent = _dotted(first["loc"][:-1])
         allowed = _allowed_keys(parent)
         msg = f"a known key; unknown key here. Allowed keys{' in ' + parent if parent else ''}: " \
               f"{', '.join(allowed)}"
@@ -455,6 +455,15 @@ def _format_validation_error(exc: ValidationError, data: Mapping[str, Any]) -> I
     more = f" (and {len(errs) - 1} more problem{'s' if len(errs) > 2 else ''})" if len(errs) > 1 \
         else ""
     return InputError(loc or "case", value, msg + more)
+
+
+def _dotted(loc: tuple) -> str:
+    """A field's name in messages: ``("faults", 0, "front")`` -> ``"faults[0].front"``, as the
+    faults' own checks name their entries (:class:`geardyn.faults.base.FaultBase`)."""
+    out = ""
+    for p in loc:
+        out += f"[{p}]" if isinstance(p, int) else (f".{p}" if out else str(p))
+    return out
 
 
 #: pydantic error types of a value that is not a number.
@@ -572,7 +581,7 @@ def load_case_details(path: str | Path | None = None,
         prov[key] = override_source
         origin[key] = override_source
     data["provenance"] = prov
-    case = _validate(data, faults_checked=faults_checked)
+    case = _validate(data, faults_checked=False)
     changed = _changed_keys(before, case, [k for k in ov if k not in _UNSOURCED])
     if changed and "name" not in ov:  # no longer the named case: say so
         data["name"] = f"{data.get('name', 'case')} (modified)"
@@ -580,10 +589,18 @@ def load_case_details(path: str | Path | None = None,
             keys = ", ".join(changed[:6]) + (", ..." if len(changed) > 6 else "")
             data["description"] = f"{data.get('description', '')} [changed by {override_source}: " \
                                   f"{keys}]".strip()
-        case = _validate(data, faults_checked=faults_checked)
+        case = _validate(data, faults_checked=False)
     origin = {**{k: "default" for k, _ in _model_leaves(case) if k not in _UNSOURCED}, **origin}
     written = {k: v for k, v in data.items() if k != "provenance"}
-    return CaseDetails(case=case, written=written, origin=origin)
+    details = CaseDetails(case=case, written=written, origin=origin)
+    if case.faults and faults_checked:  # the faults' geometry, the value as the user wrote it
+        from ..faults import check_faults
+
+        try:
+            check_faults(case)
+        except InputError as exc:
+            raise with_written_value(exc, details) from None
+    return details
 
 
 _MISSING = object()

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 import tomllib
 from importlib import resources
 from pathlib import Path
@@ -160,8 +161,9 @@ def _load_base(spec: SweepFile, base_dir: Path) -> Case:
                                            f"shipped case: {', '.join(names)}")
         return load_case(path, overrides, override_source="sweep file [set]")
     except InputError as exc:
-        if exc.field in overrides:
-            raise InputError(f"set.{exc.field}", exc.value, exc.allowed) from None
+        key = re.sub(r"\[(\d+)\]", r".\1", str(exc.field))  # faults[0].width: faults.0.width
+        if key in overrides:  # named as the sweep file's [set] table names it
+            raise InputError(f"set.{key}", exc.value, exc.allowed) from None
         raise
 
 
