@@ -17,9 +17,9 @@ EXAMPLES = Path(__file__).resolve().parents[1] / "examples" / "faults"
 def test_a_misspelt_key_of_a_fault_lists_the_keys_a_fault_has():
     with pytest.raises(InputError) as exc:
         load_case(EXAMPLES / "spall.toml", ["faults.0.widht=3mm"])
-    assert exc.value.field == "faults.0.widht"
-    assert "Allowed keys in faults.0: angle, depth," in exc.value.allowed
-    assert "width" in exc.value.allowed.split("faults.0:")[1]
+    assert exc.value.field == "faults[0].widht"  # as the faults' own checks name entries
+    assert "Allowed keys in faults[0]: angle, depth," in exc.value.allowed
+    assert "width" in exc.value.allowed.split("faults[0]:")[1]
 
 
 def test_the_wear_gap_of_a_map_has_its_unit_and_the_slot_dimension():

@@ -28,7 +28,7 @@ from geardyn.studies.report import Report
 SPALL = Path(__file__).resolve().parents[2] / "examples" / "faults" / "spall.toml"
 
 #: What a user reads as a Python leftover rather than a value.
-LEFTOVERS = ("None", "[{", "{'", "'}", "100000000.0")
+LEFTOVERS = ("None", "[{", "{'", "'}", "100000000.0", "True", "False", "69000000000.0")
 
 
 def _summary(tmp_path, case, *, quick: bool, stiffness: str | None = None) -> dict:
@@ -81,19 +81,19 @@ def test_the_case_table_shows_the_quick_values_used(tmp_path):
     case = geardyn.paper_case()
     s = _summary(tmp_path, case, quick=True)
     rows = {k: v for k, v, _ in _case_table_rows(case, [], used=used_case(case, s))}
-    assert rows["simulation.record_time"] == "1.0 s; used with --quick: 0.3 s"
+    assert rows["simulation.record_time"] == "1 s; used with --quick: 0.3 s"
     assert rows["simulation.settle_time"] == "0.5 s; used with --quick: 0.1 s"
     assert rows["stiffness.centre_distances"] == "31; used with --quick: 11"
-    assert rows["stiffness.fe.refinement"] == "1.0; used with --quick: 0.5"
+    assert rows["stiffness.fe.refinement"] == "1; used with --quick: 0.5"
     assert rows["simulation.dt"] == "1e-05 s"  # not changed: as it is
     rep = Report("t", tmp_path)
     case_sections(rep, case, s)
     text = _text(rep)
-    assert ("simulation.record_time | 1.0 s | 0.3 s (--quick; the case: 1.0 s)" in text)
+    assert ("simulation.record_time | 1 s | 0.3 s (--quick; the case: 1 s)" in text)
     assert ("--quick shortened the records and coarsened the stiffness maps: "
             "stiffness.centre_distances = 11 (the case: 31), stiffness.fe.refinement = 0.5 (the "
-            "case: 1.0), simulation.settle_time = 0.1 s (the case: 0.5 s), "
-            "simulation.record_time = 0.3 s (the case: 1.0 s).") in text
+            "case: 1), simulation.settle_time = 0.1 s (the case: 0.5 s), "
+            "simulation.record_time = 0.3 s (the case: 1 s).") in text
 
 
 def test_a_fault_case_reads_without_python_leftovers(tmp_path):
@@ -111,9 +111,9 @@ def test_a_fault_case_reads_without_python_leftovers(tmp_path):
     case_sections(rep, case, s)
     text = _text(rep)
     assert f"faults | {paper_faults} | type = spall, gear = pinion, tooth = 11" in text
-    assert "crack.enabled | yes | no" in text
+    assert "crack.enabled | true | false" in text
     assert "simulation.max_steps | 100,000,000 steps" in text
-    assert "simulation.record_time | 1.0 s; used with --quick: 0.3 s" in text
+    assert "simulation.record_time | 1 s; used with --quick: 0.3 s" in text
     for leftover in LEFTOVERS:
         assert leftover not in text, leftover
 
@@ -138,3 +138,23 @@ def test_each_work_is_cited_once_in_its_full_form():
     assert sum(c.startswith("PHM-BGU") for c in cites) == 1
     assert sum(c.startswith("Chaari, Baccar") for c in cites) == 1  # 2008, not the 2012 one
     assert len(cites) == len(set(cites)) == len(CITATIONS) + 2
+
+
+def test_the_case_table_gives_every_number_its_unit_and_angles_in_degrees_too():
+    """A user audit (2026-11-27): the case table read "0.3490658503988659 rad", "True",
+    "69000000000.0 Pa" and "[3000.0]" (no unit). Units come from the field's dimension or, for
+    plain numbers, from the unit its description states; case.toml keeps every digit."""
+    rows = {k: v for k, v, _ in _case_table_rows(geardyn.paper_case(), [])}
+    assert rows["pair.pressure_angle"] == "0.3490658504 rad (20 deg)"
+    assert rows["crack.angle"] == "0.7853981634 rad (45 deg)"
+    assert rows["motor.ripple_phase"] == "0 rad"  # no "(0 deg)" for a zero
+    assert rows["material.youngs_modulus"] == "6.9e+10 Pa"
+    assert rows["pinion.bearing_stiffness"] == "1000000 N/m"
+    assert rows["crack.enabled"] == "true" and rows["stiffness.body_torsion"] == "false"
+    assert rows["measurement.mode_frequencies"] == "[3000] Hz"
+    assert rows["measurement.mode_gains"] == "[[0.05, 0.1]] (m/s^2)/N"
+    assert rows["measurement.mode_damping_ratios"] == "[0.05]"  # [-]: dimensionless
+    assert rows["measurement.snr"] == "20 dB"
+    assert rows["diagnostics.bandwidth"] == "11 orders"
+    assert rows["pinion.teeth"] == "23" and rows["pair.addendum_coefficient"] == "1"
+    assert rows["stiffness.centre_distances"] == "31"  # not the bracketed key names

@@ -41,17 +41,64 @@ def _faults_text(entries) -> str:
                      for entry in entries) or "none"
 
 
+def _unit_of(key: str) -> str:
+    """The unit of a case field's plain numbers: its dimension's SI unit (``"Hz"`` for
+    ``measurement.mode_frequencies``), else the last bracketed unit of its description
+    (``"dB"`` for ``measurement.snr``, ``"(m/s^2)/N"`` for ``measurement.mode_gains``); "" for
+    a dimensionless field (``[-]``) or one that states none."""
+    import re
+
+    from ..config.loading import _field_description
+    from ..config.models import DIMENSIONS, _field_dimension
+
+    dim = _field_dimension(key)
+    if dim is not None:
+        return DIMENSIONS[dim].si_unit
+    units = [u for u in re.findall(r"\[([^\]]+)\]", _field_description(tuple(key.split("."))))
+             if "," not in u and u.strip() != "-"]
+    return units[-1].strip() if units else ""
+
+
+def _number_text(x) -> str:
+    """A number of the case table: an integer as it is, a float to 10 significant digits
+    (``69000000000.0`` -> ``6.9e+10``, ``1.0`` -> ``1``; case.toml keeps every digit)."""
+    return str(x) if isinstance(x, int) else f"{x:.10g}"
+
+
 def _value_text(key: str, value) -> str:
     """A case value (as case.toml holds it: quantities as SI unit strings) as the case table
     shows it: a faults list as :func:`_faults_text`, a count of :data:`COUNT_UNITS` as an
-    integer with its unit, an unset value as "not set"; no Python ``None`` or list/dict repr."""
+    integer with its unit, an unset value as "not set", a boolean as TOML writes it (``true``),
+    a number with its unit (:func:`_unit_of`) to 10 significant digits, an angle in radians with
+    its degrees beside (``0.3490658504 rad (20 deg)``); no Python ``None`` or list/dict repr."""
     if value is None:
         return "not set"
+    if isinstance(value, bool):
+        return "true" if value else "false"
     if key in COUNT_UNITS and isinstance(value, (int, float)) and float(value).is_integer():
         return f"{int(value):,} {COUNT_UNITS[key]}"
     if isinstance(value, list) and all(isinstance(v, dict) for v in value):
         return _faults_text(value)
-    return str(value)
+
+    def numbers(v):
+        return (_number_text(v) if isinstance(v, int | float) and not isinstance(v, bool)
+                else "[" + ", ".join(numbers(w) for w in v) + "]" if isinstance(v, list)
+                else str(v))
+
+    if isinstance(value, int | float | list):
+        unit = _unit_of(key)
+        return f"{numbers(value)} {unit}".strip()
+    number, _, unit = str(value).partition(" ")
+    try:
+        x = float(number)
+    except ValueError:
+        return str(value)
+    text = f"{_number_text(x)} {unit}".strip()
+    if unit == "rad" and x != 0:
+        import math
+
+        text += f" ({math.degrees(x):.6g} deg)"
+    return text
 
 
 def _case_rows(case: Case) -> list[tuple[str, str, str]]:
@@ -123,7 +170,7 @@ def _case_table_rows(case: Case, changed: list[str],
         rows = [(k, v if ran.get(k, v) == v else f"{v}; used with --quick: {ran[k]}", s)
                 for k, v, s in rows]
     off = {k.rsplit(".", 1)[0] for k, v, _ in rows
-           if k.endswith(".enabled") and v == "False"}
+           if k.endswith(".enabled") and v == "false"}
     out = []
     for key, value, source in rows:
         section = key.rsplit(".", 1)[0]
@@ -175,7 +222,7 @@ def _difference_text(key: str, value, case: Case) -> str:
     from .report import fmt
 
     if isinstance(value, bool):
-        return fmt(value)
+        return _value_text(key, value)
     if key in _COMPUTED_UNITS:
         return "not set" if value is None else f"{fmt(value)} {_COMPUTED_UNITS[key]}"
     shown = {k: v for k, v, _ in _case_rows(case)}
