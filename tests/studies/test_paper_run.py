@@ -81,7 +81,8 @@ def test_model_ii_differs_from_model_i_where_the_paper_says(run_dir):
         d = abs(sig["II"]["pm_mean_deg"] - sig["I"]["pm_mean_deg"]) % 360
         assert min(d, 360 - d) > 10  # the PM level moves between the models
     cm = s["condition_metrics"]["gear_vertical_velocity"]
-    for m in ("I", "II"):
+    assert set(cm) == {"I", "I-static", "II"}  # I-static: geardyn's addition, both states
+    for m in ("I", "I-static", "II"):
         assert cm[m]["cracked"]["FM4"] > 1.5 * cm[m]["healthy"]["FM4"]
         assert cm[m]["cracked"]["EnergyRatio"] > 1.5 * cm[m]["healthy"]["EnergyRatio"]
 
@@ -133,6 +134,10 @@ def test_results_open_the_obvious_way_and_are_compressed(run_dir):
     root.close()
     tree = xr.open_datatree(out / "results.nc", engine="h5netcdf")
     assert {"stiffness", "diagnostics"} <= set(tree.children)
+    # every model in both states (model I-static's healthy record was simulated but not
+    # diagnosed until 2026-11-27)
+    assert set(tree["diagnostics"].children) == {f"model_{m}_{st}" for m in ("I", "I-static", "II")
+                                                 for st in ("healthy", "cracked")}
     assert {"healthy", "cracked"} <= set(tree["stiffness"].children)
     assert tree["diagnostics/model_II_cracked"]["v_yg_tsa"].attrs["units"] == "m/s"
     tree.close()
@@ -256,7 +261,7 @@ def test_undefined_metrics_and_run_times(run_dir):
     p.feed((out / "report.html").read_text())
     na4 = [c for c in p.rows if len(c) == 6 and c[1][0] == "NA4star"]
     er = [c for c in p.rows if len(c) == 6 and c[1][0] == "EnergyRatio"]
-    assert len(na4) == len(er) == 6
+    assert len(na4) == len(er) == 9  # three signals, models I, I-static and II
     assert all(c[2][0] == c[3][0] == c[4][0] == "undefined" for c in na4)
     assert all(c[4][0] == "undefined" for c in er)
     stages = {c[0][0] for c in p.rows if len(c) == 2}
@@ -578,4 +583,5 @@ def test_progress_one_bar_per_stage_with_its_own_count(run_dir, run_cache, tmp_p
         assert len(totals) == 1, (bar, seq)
         dones = [d for d, _ in seq]
         assert dones == sorted(dones) and dones[-1] == seq[-1][1], (bar, seq)
-    assert bars["simulation"][-1] == (7, 7) and bars["diagnostics"][-1] == (5, 5)
+    # seven records; six diagnosed (models I, I-static and II, both states: not II-start)
+    assert bars["simulation"][-1] == (7, 7) and bars["diagnostics"][-1] == (6, 6)

@@ -296,7 +296,7 @@ def test_a_warm_run_into_a_new_folder_recomputes_nothing(tmp_path, monkeypatch):
     with record_lookups() as cold:
         a = run_paper_study(case, tmp_path / "a", quick=True, stiffness="pem")
     cold = _counts(cold)
-    assert cold["diagnosis"] == {"hits": 0, "built": 5}
+    assert cold["diagnosis"] == {"hits": 0, "built": 6}  # models I, I-static, II x 2 states
     assert cold["figure"]["hits"] == 0 and cold["output"] == {"hits": 0, "built": 9}
     assert cold["map values"] == {"hits": 0, "built": 1}
 
@@ -308,7 +308,7 @@ def test_a_warm_run_into_a_new_folder_recomputes_nothing(tmp_path, monkeypatch):
         b = run_paper_study(case, tmp_path / "b", quick=True, stiffness="pem")
     warm = _counts(warm)
     assert warm["figure"] == {"hits": cold["figure"]["built"], "built": 0}
-    assert warm["diagnosis"] == {"hits": 5, "built": 0}
+    assert warm["diagnosis"] == {"hits": 6, "built": 0}
     assert warm["output"] == {"hits": 9, "built": 0}
     assert warm["map values"] == {"hits": 1, "built": 0}
     assert all(v["built"] == 0 for v in warm.values()), warm

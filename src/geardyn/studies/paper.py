@@ -750,7 +750,7 @@ def diagnostics_stage(case: Case, out: Path, result: StudyResult) -> None:
     z = case.pinion.teeth
     cache = default_cache()
     diags, inputs, keys_of = {}, {}, {}
-    keys = [k for k in result.sims if k[0] in ("I", "II") or k == ("I-static", "cracked")]
+    keys = [k for k in result.sims if k[0] in ("I", "II", "I-static")]
     drawn = (("I", "cracked"), ("II", "cracked"))  # the diagnoses the figures show
     for i, key in enumerate(keys):
         result.emit(f"diagnostics: model {key[0]}, {key[1]}", i, len(keys))
@@ -788,7 +788,10 @@ def diagnostics_stage(case: Case, out: Path, result: StudyResult) -> None:
     # healthy vs cracked condition metrics (NA4* with the healthy residual as baseline)
     periodic = healthy_baseline_is_periodic(result.maps["healthy"])
     detect: dict = {}
-    for m in ("I", "II"):
+    # model I-static too (geardyn's addition): whether a metric sees the fault without model
+    # II's iteration is the question the model study asks
+    for m in [m for m in ("I", "I-static", "II")
+              if (m, "healthy") in diags and (m, "cracked") in diags]:
         for sig, name in SIGNAL_KEYS.items():
             h = diags[(m, "healthy")].signals[sig].tsa.average
             c = diags[(m, "cracked")].signals[sig].tsa.average
