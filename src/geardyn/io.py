@@ -362,3 +362,52 @@ def read_netcdf(path: str | os.PathLike, required: Iterable[str] = ()):
     if missing:
         raise DataFileError(p, f"lacks the variable(s) {', '.join(missing)}")
     return ds
+
+
+#: Attribute (MATLAB copy) and ``#`` header key (CSV copy) of the SHA-256 of the inputs of the
+#: record a copy was written from (:func:`inputs_sha256`).
+COPY_STAMP = "geardyn_inputs_sha256"
+
+
+def inputs_sha256(inputs: object) -> str:
+    """SHA-256 (hex) of a record's inputs (``geardyn_inputs``: a dict, or its JSON text) in a
+    canonical JSON form (sorted keys), so that a CSV or MATLAB copy of the record can be told
+    from a copy of another record with :func:`copy_inputs_sha256`."""
+    import hashlib
+
+    if isinstance(inputs, str):
+        inputs = json.loads(inputs)
+    text = json.dumps(inputs, sort_keys=True, separators=(",", ":"), default=str)
+    return hashlib.sha256(text.encode("utf-8")).hexdigest()
+
+
+def copy_inputs_sha256(path: str | os.PathLike) -> str | None:
+    """The :data:`COPY_STAMP` of a CSV copy (a ``# geardyn_inputs_sha256 = ...`` line of its
+    header) or a MATLAB copy (``attrs.geardyn_inputs_sha256``, else the SHA-256 of its
+    ``attrs.geardyn_inputs``); None where the file has none or cannot be read (a file geardyn
+    did not write, or wrote before the stamp)."""
+    p = Path(path)
+    try:
+        if p.suffix.lower() == ".csv":
+            with open(p, encoding="utf-8", errors="replace") as fh:
+                for _ in range(200):
+                    line = fh.readline()
+                    if not line.startswith("#"):
+                        return None
+                    key, sep, value = line[1:].partition("=")
+                    if sep and key.strip() == COPY_STAMP:
+                        return value.strip()
+            return None
+        from scipy.io import loadmat
+
+        attrs = loadmat(p, variable_names=["attrs"], squeeze_me=True,
+                        struct_as_record=False).get("attrs")
+        if attrs is None:
+            return None
+        stamp = getattr(attrs, COPY_STAMP, None)
+        if isinstance(stamp, str) and stamp:
+            return stamp
+        inputs = getattr(attrs, "geardyn_inputs", None)
+        return inputs_sha256(inputs) if isinstance(inputs, str) and inputs else None
+    except (OSError, ValueError, TypeError, NotImplementedError):
+        return None

@@ -81,3 +81,61 @@ def test_measure_rerun_is_up_to_date(tmp_path):
     assert r.returncode == 0 and out.with_suffix(".csv").exists(), r.stderr
     r = _run(tmp_path, *args[:-2], "--no-crack", "--out", out)
     assert r.returncode == 2 and "crack True -> False" in r.stderr, r.stderr
+
+
+def test_a_record_named_as_its_copy_is_refused(tmp_path):
+    """``measure --out y.mat --mat`` wrote a NetCDF file named y.mat, which MATLAB could not
+    read, and simulate's .mat copy overwrote its own record (a user audit, 2026-11-27)."""
+    for cmd, name, flag in (("measure", "y.mat", "--mat"), ("measure", "y.csv", "--csv"),
+                            ("simulate", "s.mat", "--mat")):
+        r = _run(tmp_path, cmd, "--stiffness", "pem", flag, "--out", tmp_path / name)
+        assert r.returncode == 2, r.stderr
+        assert f"--out: got '{tmp_path / name}'" in r.stderr, r.stderr
+        assert f"e.g. {name[:-4]}.nc ({flag} writes {name} beside it)" in r.stderr, r.stderr
+        assert "Traceback" not in r.stderr and not (tmp_path / name).exists()
+
+
+@pytest.mark.slow
+def test_copies_of_a_replaced_record_are_not_left_behind(tmp_path):
+    """A forced re-measure without --csv/--mat left the old record's copies beside the new
+    record, and a later run with --csv --mat found them there and kept them (they held the old
+    SNR). Now each copy carries the SHA-256 of its record's inputs: a copy of another record is
+    removed when not asked for, rewritten when asked for."""
+    import numpy as np
+    from scipy.io import loadmat
+
+    from geardyn.io import copy_inputs_sha256, inputs_sha256
+
+    out = tmp_path / "r.nc"
+    base = ["measure", "--stiffness", "pem", "--set", "simulation.record_time=0.2 s",
+            "--set", "stiffness.centre_distances=6", "--set", "stiffness.nodes_per_segment=8",
+            "--out", out]
+    r = _run(tmp_path, *base, "--csv", "--mat")
+    assert r.returncode == 0, r.stderr
+    old = copy_inputs_sha256(out.with_suffix(".csv"))
+    assert old == copy_inputs_sha256(out.with_suffix(".mat")) == inputs_sha256(
+        xr.open_dataset(out).attrs["geardyn_inputs"])
+    r = _run(tmp_path, *base, "--set", "measurement.snr=10", "--force")
+    assert r.returncode == 0, r.stderr
+    assert f"removed {out.with_suffix('.csv')}, {out.with_suffix('.mat')}" in r.stderr, r.stderr
+    assert not out.with_suffix(".csv").exists() and not out.with_suffix(".mat").exists()
+    # a stale copy put back (as a user restoring a backup would): rewritten when asked for
+    r = _run(tmp_path, *base, "--set", "measurement.snr=10", "--csv")
+    assert r.returncode == 0, r.stderr
+    fresh = out.with_suffix(".csv").read_text()
+    stale = fresh.replace(copy_inputs_sha256(out.with_suffix(".csv")), old)
+    out.with_suffix(".csv").write_text(stale)
+    r = _run(tmp_path, *base, "--set", "measurement.snr=10", "--csv", "--mat")
+    assert r.returncode == 0 and "up to date" in r.stderr, r.stderr
+    assert f"wrote {out.with_suffix('.csv')}, {out.with_suffix('.mat')} from it" in r.stderr
+    assert out.with_suffix(".csv").read_text() == fresh
+    with xr.open_dataset(out) as ds:
+        acc = ds["acc"].values
+    m = loadmat(out.with_suffix(".mat"))
+    np.testing.assert_array_equal(m["acc"][:, 0], acc)
+    assert float(np.squeeze(m["attrs"]["snr_requested"][0, 0])) == 10.0
+    # a file of the same name that geardyn did not write (no stamp) is not removed
+    own = out.with_suffix(".csv")
+    own.write_text("time,acc\n0,1\n")
+    r = _run(tmp_path, *base, "--set", "measurement.snr=10", "--force")
+    assert r.returncode == 0 and own.read_text() == "time,acc\n0,1\n", r.stderr

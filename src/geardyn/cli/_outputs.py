@@ -255,6 +255,49 @@ def claim_file(target: OutputTarget, ident: dict[str, Any], *, force: bool,
     return not diff and not force and (not companions_needed
                                        or all(c.exists() for c in companions))
 
+#: Suffixes of the copies a record command writes beside its NetCDF file (``--csv``, ``--mat``).
+COPY_SUFFIXES = (".csv", ".mat")
+
+
+def check_record_name(target: OutputTarget, copies: tuple[str, ...] = COPY_SUFFIXES) -> None:
+    """Refuse a NetCDF record's ``--out`` named as one of its copies (``y.mat``): the record
+    is NetCDF whatever its name, so ``y.mat`` was a NetCDF file MATLAB cannot read, and
+    ``--mat`` wrote the copy over the record (a user audit, 2026-11-27)."""
+    suffix = target.path.suffix.lower()
+    if suffix in copies:
+        flag = {".csv": "--csv", ".mat": "--mat"}[suffix]
+        raise InputError("--out", str(target.path),
+                         f"the NetCDF record's file name, e.g. "
+                         f"{target.path.with_suffix('.nc').name} ({flag} writes "
+                         f"{target.path.name} beside it)")
+
+
+def copies_to_refresh(out: Path, inputs_json: str, wanted: tuple[Path, ...]
+                      ) -> tuple[list[Path], list[Path]]:
+    """The CSV and MATLAB copies of the record ``out`` (of inputs ``inputs_json``, its
+    ``geardyn_inputs``) to write and to remove.
+
+    To write: each ``wanted`` copy that is missing or is not a copy of these inputs (its
+    :data:`geardyn.io.COPY_STAMP` differs or is missing). To remove: a copy beside ``out`` that
+    is not wanted and is stamped as a copy of other inputs (a record this one replaced), so no
+    copy of another record is left looking like this one's; a file without a stamp is not
+    geardyn's to remove.
+    """
+    from ..io import copy_inputs_sha256, inputs_sha256
+
+    stamp = inputs_sha256(inputs_json)
+    write = [c for c in wanted if not c.exists() or copy_inputs_sha256(c) != stamp]
+    remove = []
+    for suffix in COPY_SUFFIXES:
+        c = out.with_suffix(suffix)
+        if c in wanted or not c.is_file():
+            continue
+        other = copy_inputs_sha256(c)
+        if other is not None and other != stamp:
+            remove.append(c)
+    return write, remove
+
+
 def check_writable(target: OutputTarget, *, folder: bool = True) -> None:
     """Refuse, before any work, an output that cannot be written.
 

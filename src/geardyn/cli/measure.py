@@ -55,12 +55,20 @@ def measure(
     import json
     from typing import get_args
 
-    from ._outputs import check_writable, claim_file, identity, resolve
+    from ._outputs import (
+        check_record_name,
+        check_writable,
+        claim_file,
+        copies_to_refresh,
+        identity,
+        resolve,
+    )
 
     target = resolve(out, DEFAULT_OUT)
     out = target.path
     # before loading anything heavy: an unwritable --out (or one below a file, or a folder)
     # fails at once, not after the simulation
+    check_record_name(target)
     check_writable(target, folder=False)
 
     from ..case_checks import check_measurement
@@ -92,16 +100,30 @@ def measure(
     # the CSV and MATLAB copies are other formats of the same record, not other inputs: a
     # re-run with fewer of them is up to date, one with more writes them from the record
     ident = identity("measure", case, {"crack": crack})
+    inputs_json = json.dumps(ident)
+
+    def remove_stale(stale: list[Path]) -> None:
+        """Copies of a record this one replaced: removed, and said (issue 6, "nothing
+        silently wrong": a forced re-run without --csv left the old record's CSV)."""
+        for c in stale:
+            c.unlink(missing_ok=True)
+        if stale:
+            err_console.print(f"[dim]removed {', '.join(str(c) for c in stale)}: a copy of "
+                              f"the record {out} held before[/dim]", highlight=False,
+                              soft_wrap=True)
+
     if claim_file(target, ident, force=force, companions=companions, companions_needed=False):
-        missing = [c for c in companions if not c.exists()]
-        if missing:
+        # copies missing, or left by a record this one replaced, are written from the record
+        stale_wanted, stale_other = copies_to_refresh(out, inputs_json, companions)
+        remove_stale(stale_other)
+        if stale_wanted:
             from ..io import read_netcdf
 
             record = read_netcdf(out)
-            for c in missing:
+            for c in stale_wanted:
                 (write_csv if c.suffix == ".csv" else write_mat)(record, c)
             err_console.print(f"[dim]{out} is up to date (same inputs); wrote "
-                              f"{', '.join(str(c) for c in missing)} from it[/dim]",
+                              f"{', '.join(str(c) for c in stale_wanted)} from it[/dim]",
                               highlight=False, soft_wrap=True)
         else:
             err_console.print(f"[dim]{out} is up to date (same inputs); --force recomputes "
@@ -119,7 +141,8 @@ def measure(
         bar.update(task, description=f"model {which}", completed=0, total=None)
         result = run_measure(case, smap, model=which, cracked=crack, progress=tick)
     ds = result.record
-    ds.attrs["geardyn_inputs"] = json.dumps(ident)
+    ds.attrs["geardyn_inputs"] = inputs_json
+    remove_stale(copies_to_refresh(out, inputs_json, companions)[1])
     written = [str(out)]
     if csv:
         write_csv(ds, out.with_suffix(".csv"))

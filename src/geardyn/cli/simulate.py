@@ -89,7 +89,9 @@ def simulate(
     from ..run_limits import check_step_count
     from ._outputs import (
         OutputInUse,
+        check_record_name,
         check_writable,
+        copies_to_refresh,
         differences,
         identity,
         refuse_different,
@@ -101,6 +103,7 @@ def simulate(
     stiffness = choice("--stiffness", stiffness, ("pem", "fe"))
     target = resolve(out, DEFAULT_OUT)
     out = target.path
+    check_record_name(target)  # the record is NetCDF whatever its name: not "x.mat"
     check_writable(target, folder=False)  # before loading anything heavy
     old, complete = _recorded_identity(out) if out.exists() else (None, None)
     if out.exists() and old is None and not force:  # refused before the case and the imports
@@ -167,7 +170,15 @@ def simulate(
         ds.attrs["geardyn_inputs"] = json.dumps(ident)
         save_netcdf(ds, out)
     written = [str(out)]
-    if mat and (not up_to_date or not mat_path.exists()):
+    # the .mat copy: written when missing or a copy of another record (one this replaced); an
+    # unwanted copy of another record is removed, so none is left looking like this one's
+    stale_wanted, stale_other = copies_to_refresh(
+        out, ds.attrs["geardyn_inputs"], (mat_path,) if mat else ())
+    for c in stale_other:
+        c.unlink(missing_ok=True)
+        err_console.print(f"[dim]removed {c}: a copy of the record {out} held before[/dim]",
+                          highlight=False, soft_wrap=True)
+    if mat and (not up_to_date or stale_wanted):
         save_mat(ds, mat_path)
     if mat:
         written.append(str(mat_path))

@@ -35,6 +35,10 @@ def save_mat(ds, path: str | os.PathLike) -> None:
     out["units"] = units
     out["attrs"] = {k: (v if isinstance(v, str | int | float) else str(v))
                     for k, v in ds.attrs.items()}
+    if "geardyn_inputs" in ds.attrs:  # which record this is a copy of (a rerun checks it)
+        from ..io import COPY_STAMP, inputs_sha256
+
+        out["attrs"][COPY_STAMP] = inputs_sha256(ds.attrs["geardyn_inputs"])
     with atomic_path(path, suffix=".mat") as tmp:
         with open(tmp, "wb") as fh:
             # long_field_names: attribute names such as static_centre_distance_change_units

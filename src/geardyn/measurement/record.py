@@ -90,7 +90,7 @@ def write_netcdf(ds, path: str | os.PathLike) -> None:
 
 def write_csv(ds, path: str | os.PathLike) -> None:
     """Write ``time, acc, acc_g, tach`` as CSV with a ``#`` provenance header, atomically."""
-    from ..io import write_text_atomic
+    from ..io import COPY_STAMP, inputs_sha256, write_text_atomic
 
     lines = [f"# fs = {float(ds.attrs['fs']):.17g} Hz"]
     for k in ("title", "case", "pinion_teeth", "gear_teeth", "noise_seed", "snr_requested",
@@ -98,6 +98,8 @@ def write_csv(ds, path: str | os.PathLike) -> None:
               "geardyn_version"):
         if k in ds.attrs:
             lines.append(f"# {k} = {ds.attrs[k]}")
+    if "geardyn_inputs" in ds.attrs:  # which record this is a copy of (a rerun checks it)
+        lines.append(f"# {COPY_STAMP} = {inputs_sha256(ds.attrs['geardyn_inputs'])}")
     names = ["time", "acc", "acc_g", "tach"]
     lines.append("# units: " + ", ".join(
         f"{n} [{ds[n].attrs.get('units', '')}]" for n in names))
@@ -125,5 +127,9 @@ def write_mat(ds, path: str | os.PathLike) -> None:
     attrs = {k: (v.item() if isinstance(v, np.generic) else v) for k, v in ds.attrs.items()}
     out["attrs"] = {k: (v if isinstance(v, str | int | float) else str(v))
                     for k, v in attrs.items()}
+    if "geardyn_inputs" in attrs:  # which record this is a copy of (a rerun checks it)
+        from ..io import COPY_STAMP, inputs_sha256
+
+        out["attrs"][COPY_STAMP] = inputs_sha256(attrs["geardyn_inputs"])
     with atomic_path(Path(path), suffix=".mat") as tmp, open(tmp, "wb") as fh:
         savemat(fh, out, do_compression=True, oned_as="column", long_field_names=True)
