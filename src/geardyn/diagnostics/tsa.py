@@ -457,13 +457,47 @@ def _warn_unresolved_edges(s: np.ndarray, i: np.ndarray, edge: str = "rising") -
         )
 
 
+#: Largest step between two sample times, in the larger of its two neighbouring steps, that
+#: is not a gap in the record: one dropped sample (a step of 2) passes, so does a DAQ's
+#: timestamp jitter; a lost DAQ buffer does not.
+MAX_STEP_RATIO = 2.5
+
+
+def _check_no_gap(x: np.ndarray, dx: np.ndarray, name: str, unit: str) -> None:
+    """Refuse samples with a gap: a step of ``x`` (sample times [s]) above
+    :data:`MAX_STEP_RATIO` times both its neighbouring steps. (Not applied to a shaft angle
+    alone: synthetic angles may step unevenly on purpose.)
+
+    The TSA interpolates each signal onto equal angle steps; across a gap it would draw a line
+    where the record has nothing. A line through the 7.8 ms of 200 samples cut out of a
+    25.6 kHz record (a user audit of 2026-11-27) averaged into a dip of seven times the
+    signal's amplitude at a wrong angle, with nothing said: a fault that is not there."""
+    if dx.size < 3:
+        return
+    near = np.maximum(np.r_[dx[1], dx[:-1]], np.r_[dx[1:], dx[-2]])  # the larger neighbour
+    gaps = np.flatnonzero(dx > MAX_STEP_RATIO * near)
+    if gaps.size == 0:
+        return
+    worst = int(gaps[np.argmax(dx[gaps] / near[gaps])])
+    raise InputError(
+        name, f"a gap of {dx[worst]:.4g} {unit} after {name} = {x[worst]:.6g} {unit}",
+        f"samples without gaps (about {dx[worst] / near[worst] - 1:.0f} samples are missing "
+        f"there at the neighbouring steps of {near[worst]:.4g} {unit}"
+        + (f"; {gaps.size} gaps in all" if gaps.size > 1 else "")
+        + f"; a step may be at most {MAX_STEP_RATIO:g} times its neighbours): the TSA would "
+        "interpolate across the gap; diagnose the parts before and after it as records of "
+        "their own")
+
+
 def _sample_times(n: int, fs: float | None, time) -> np.ndarray:
     if time is not None:
         t = _as_float_array(time, "time", min_size=2)
         if t.shape[0] != n:
             raise InputError("time", f"{t.shape[0]} samples", f"{n} samples, like the signal")
-        if not np.all(np.diff(t) > 0):
+        dt = np.diff(t)
+        if not np.all(dt > 0):
             raise InputError("time", "non-increasing sample times", "strictly increasing times")
+        _check_no_gap(t, dt, "time", "s")
         return t
     if fs is None:
         raise InputError("fs", None, "a sample rate in Hz (or pass time=)")
@@ -662,6 +696,8 @@ def tsa(
         if ang.shape[0] != n:
             raise InputError("angle", f"{ang.shape[0]} samples", f"{n} samples, like x")
         ang, d = _check_angle(ang, "angle", unwrap)
+        if time is not None:  # the sample times beside the angle: a gap in them is one here
+            _sample_times(n, fs, time)
         method = "angle"
         origin = float(angle_origin)
     else:
