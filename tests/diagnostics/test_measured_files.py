@@ -231,6 +231,57 @@ def test_units_from_the_file(tmp_path):
         diagnose_file(tmp_path / "daq.nc", signals="acc", tach="tach", teeth=Z, **FAST)
 
 
+def _as_dict(metrics) -> dict:
+    from dataclasses import asdict
+
+    return asdict(metrics)
+
+
+def test_time_and_angle_columns_in_the_units_they_state(tmp_path):
+    """A time column "time [ms]" was read as seconds (a shaft 1000 times slower, nothing said)
+    and "angle [deg]" as radians without --angle-unit (a user audit, 2026-11-27). The oracle:
+    the same record in s and rad, diagnosed the same to round-off; a contradicting
+    --angle-unit and a unit that is no time are refused; a matrix column's index is not its
+    unit."""
+    t, theta, acc = _record()
+    tach = _pulses(t, theta)
+    _, _, _, ref = _plain(tmp_path)
+    ms = tmp_path / "ms.csv"
+    np.savetxt(ms, np.c_[t * 1e3, acc, tach], delimiter=",", comments="", fmt="%.12g",
+               header="time [ms],acc [g],tach [V]")
+    r = diagnose_file(ms, signals="acc [g]", time="time [ms]", tach="tach [V]", teeth=Z, **FAST)
+    assert _as_dict(r.signals["acc [g]"].metrics) == pytest.approx(_as_dict(ref.metrics),
+                                                                   rel=1e-7, nan_ok=True)
+    assert r.settings["shaft_speed_rev_s"]["mean"] == pytest.approx(25.0, rel=1e-4)
+    deg = tmp_path / "deg.csv"
+    np.savetxt(deg, np.c_[t, acc, np.degrees(theta)], delimiter=",", comments="", fmt="%.15g",
+               header="time [s],acc [g],angle [deg]")
+    rad = tmp_path / "rad.csv"
+    np.savetxt(rad, np.c_[t, acc, theta], delimiter=",", comments="", fmt="%.15g",
+               header="time [s],acc [g],angle")
+    by_deg = diagnose_file(deg, signals="acc [g]", time="time [s]", angle="angle [deg]",
+                           teeth=Z, **FAST).signals["acc [g]"]
+    by_rad = diagnose_file(rad, signals="acc [g]", time="time [s]", angle="angle", teeth=Z,
+                           **FAST).signals["acc [g]"]
+    assert _as_dict(by_deg.metrics) == pytest.approx(_as_dict(by_rad.metrics), rel=1e-7,
+                                                     nan_ok=True)
+    with pytest.raises(InputError) as err:
+        diagnose_file(deg, signals="acc [g]", time="time [s]", angle="angle [deg]",
+                      angle_unit="rad", teeth=Z, **FAST)
+    assert err.value.field == "angle_unit" and "'angle [deg]' states, deg" in err.value.allowed
+    bad = tmp_path / "bad.csv"
+    np.savetxt(bad, np.c_[t, acc, tach], delimiter=",", comments="", fmt="%.10g",
+               header="time [V],acc [g],tach [V]")
+    with pytest.raises(InputError, match="in 'V'") as err:
+        diagnose_file(bad, signals="acc [g]", time="time [V]", tach="tach [V]", teeth=Z, **FAST)
+    assert err.value.field == "time"
+    mat = tmp_path / "counts.mat"
+    scipy.io.savemat(mat, {"data": np.c_[np.round(acc * 1000), tach].astype(np.int16),
+                           "fs": FS})
+    r = diagnose_file(mat, signals=0, tach=1, teeth=Z, **FAST)
+    assert [s.unit for s in r.signals.values()] == [""]  # not "0"
+
+
 # ------------------------------------------------------------------------------ teeth
 def test_a_tooth_count_the_spectrum_contradicts_is_warned():
     t, theta, acc = _record()

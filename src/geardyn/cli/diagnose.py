@@ -64,7 +64,9 @@ def diagnose(
                                              show_default=False)] = None,
     angle: Annotated[str | None, typer.Option("--angle", help="Shaft angle column.",
                                               show_default=False)] = None,
-    angle_unit: Annotated[str, typer.Option("--angle-unit", help="rad, deg or rev.")] = "rad",
+    angle_unit: Annotated[str | None, typer.Option(
+        "--angle-unit", help="rad, deg or rev (default: the unit the angle column states, as "
+                             "in 'angle [deg]', else rad).", show_default=False)] = None,
     unwrap_angle: Annotated[bool, typer.Option(
         "--unwrap-angle", help="The angle column is wrapped (0..360 deg per turn, as an "
                                "encoder's position reads): unwrap it.")] = False,

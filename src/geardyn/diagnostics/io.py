@@ -279,7 +279,8 @@ def unit_in_name(name: str) -> str:
     """The unit a column name ends with, in brackets or parentheses (``"acc [g]"`` -> ``"g"``,
     ``"force (N)"`` -> ``"N"``), else ``""``."""
     m = _UNIT_IN_NAME.search(str(name))
-    return m.group(1) if m else ""
+    # "data[0]" names column 0 of a matrix: an index, not a unit
+    return m.group(1) if m and not m.group(1).strip().isdigit() else ""
 
 
 _UNITS_COMMENT = re.compile(r"^\s*#\s*units\s*:\s*(.*)$", re.I)

@@ -134,6 +134,53 @@ def load_simulation(path, *, signals: Sequence[str] | None = None,
                        teeth=teeth, units=units, source=str(path))
 
 
+#: Units of an angle column: name -> radians per unit.
+_ANGLE_UNITS = {"rad": 1.0, "deg": np.pi / 180.0, "rev": 2.0 * np.pi}
+#: How files write them (a column name's brackets, a units attribute) -> :data:`_ANGLE_UNITS`.
+_ANGLE_SPELLINGS = {"rad": "rad", "radian": "rad", "radians": "rad", "deg": "deg",
+                    "degree": "deg", "degrees": "deg", "\u00b0": "deg", "rev": "rev",
+                    "revs": "rev", "revolution": "rev", "revolutions": "rev", "turn": "rev",
+                    "turns": "rev"}
+
+
+def _column_name(table, key) -> str:
+    """The name of a column given by name or position."""
+    return key if isinstance(key, str) and key in table.columns else table.names[int(key)]
+
+
+def _stated_unit(table, key) -> str:
+    """The unit the file states for a column: its units entry, else its name's brackets."""
+    try:
+        name = _column_name(table, key)
+    except (IndexError, ValueError, TypeError):
+        return ""  # table.get names the bad column
+    return (table.units.get(name) or table.text.get(f"units.{name}", "")
+            or unit_in_name(name)).strip()
+
+
+def _angle_unit_stated(table, key) -> str | None:
+    """rad, deg or rev as the angle column states it; None where it states none."""
+    unit = _stated_unit(table, key)
+    return _ANGLE_SPELLINGS.get(unit.lower()) if unit else None
+
+
+def _time_scale(table, key, field: str) -> float:
+    """Seconds per unit of a time column: 1 unless it states another time unit ("time [ms]"
+    was read as seconds, a 1000 times slower shaft, with nothing said: a user audit of
+    2026-11-27)."""
+    unit = _stated_unit(table, key)
+    if not unit or unit == "s":
+        return 1.0
+    from ..units import to_si
+
+    try:
+        return float(to_si(f"1 {unit}", "time", field))
+    except InputError:
+        raise InputError(field, f"column {_column_name(table, key)!r} in {unit!r}",
+                         "a time column in s, or in a time unit its name or the file states "
+                         "(ms, us, min)") from None
+
+
 def load_measurement(
     path,
     *,
@@ -147,7 +194,7 @@ def load_measurement(
     tach_threshold: float | None = None,
     tach_edge: str = "rising",
     tach_min_interval: float | None = None,
-    angle_unit: str = "rad",
+    angle_unit: str | None = None,
     unwrap_angle: bool = False,
     units: Mapping[str, str] | None = None,
     option_names: Mapping[str, str] | None = None,
@@ -180,7 +227,8 @@ def load_measurement(
         Sample rate [Hz]; if absent, a scalar ``fs`` stored in the file is used. Not with
         ``time``; for a file that stores its rate, only that rate.
     time : str or int, optional
-        Column of sample times [s].
+        Column of sample times: in s, or in the time unit the column states (its name,
+        ``"time [ms]"``, or the file's units), converted to s.
     angle : str or int, optional
         Column of shaft angle (unit ``angle_unit``).
     tach : str or int, optional
@@ -199,8 +247,10 @@ def load_measurement(
     tach_min_interval : float, optional
         Shortest time between two pulses [s]: edges closer than this to the last one kept
         (noise on a slow edge, chatter) are dropped.
-    angle_unit : {"rad", "deg", "rev"}
-        Unit of the angle column.
+    angle_unit : {"rad", "deg", "rev"}, optional
+        Unit of the angle column; default the unit the column states (its name,
+        ``"angle [deg]"``, or the file's units), else rad. One that contradicts the column's
+        is refused.
     unwrap_angle : bool
         Unwrap a wrapped angle column (0..2*pi sawtooth).
     units : mapping, optional
@@ -260,7 +310,7 @@ def load_measurement(
         raise DataFileError(path, f"stores a sample rate {rate_key} = {stored_fs:g}, not a "
                                   f"positive number of Hz: give the rate ({fs_}) or a time "
                                   f"column ({time_})")
-    t = None if time is None else table.get(time, time_)
+    t = None if time is None else table.get(time, time_) * _time_scale(table, time, time_)
     if fs is None and t is None:
         timelike = [c for c in table.names
                     if re.match(r"(?i)^\s*(time|t)\b", c) and c not in signals]
@@ -289,7 +339,7 @@ def load_measurement(
             raise InputError(name_of(key), value, f"no {name_of(key)} with "
                              f"{name_of('tach_column_is_pulse_times')}: it finds the edges of a "
                              "sampled pulse train, and the column already lists pulse times")
-    if angle is None and angle_unit != "rad":  # the tachometer's angle has no unit to give
+    if angle is None and angle_unit is not None:  # the tachometer's angle has no unit
         raise InputError(name_of("angle_unit"), angle_unit,
                          f"no {name_of('angle_unit')} with a tachometer channel (it is the unit "
                          f"of an {name_of('angle')} channel)")
@@ -298,9 +348,16 @@ def load_measurement(
                          f"no {name_of('unwrap_angle')} with a tachometer channel (it unwraps "
                          f"an {name_of('angle')} channel)")
     if angle is not None:
-        scale = {"rad": 1.0, "deg": np.pi / 180.0, "rev": 2.0 * np.pi}.get(angle_unit)
+        stated = _angle_unit_stated(table, angle)
+        if angle_unit is None:
+            angle_unit = stated or "rad"
+        scale = _ANGLE_UNITS.get(angle_unit)
         if scale is None:
             raise InputError(name_of("angle_unit"), angle_unit, "'rad', 'deg' or 'rev'")
+        if stated is not None and stated != angle_unit:
+            raise InputError(name_of("angle_unit"), angle_unit,
+                             f"the unit the angle column {_column_name(table, angle)!r} states, "
+                             f"{stated}, or no {name_of('angle_unit')}")
         ang = table.get(angle, name_of("angle")) * scale
         if unwrap_angle:
             ang = np.unwrap(ang)

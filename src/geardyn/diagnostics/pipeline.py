@@ -566,7 +566,7 @@ def diagnose_file(
     tach_threshold: float | None = None,
     tach_edge: str = "rising",
     tach_min_interval: float | None = None,
-    angle_unit: str = "rad",
+    angle_unit: str | None = None,
     unwrap_angle: bool = False,
     default_teeth: int | None = None,
     option_names: Mapping[str, str] | None = None,
@@ -645,7 +645,7 @@ def diagnose_file(
         # the exact angle theta_p: the options of a measured angle would be ignored silently
         for key, value, idle in (("tach_column_is_pulse_times", tach_column_is_pulse_times,
                                   False), ("pulses_per_rev", pulses_per_rev, None),
-                                 ("angle_unit", angle_unit, "rad"), ("tach_edge", tach_edge,
+                                 ("angle_unit", angle_unit, None), ("tach_edge", tach_edge,
                                                                      "rising"),
                                  ("unwrap_angle", unwrap_angle, False),
                                  ("tach_threshold", tach_threshold, None),
