@@ -247,3 +247,22 @@ def test_bad_pulse_times_are_named_by_the_tach_option(tmp_path):
         diagnose_file(path, signals="acc", tach="tach", tach_column_is_pulse_times=True, fs=FS,
                       teeth=25)
     assert exc.value.field == "tach"
+
+
+def test_force_replaces_the_earlier_figures_too(tmp_path):
+    """``--force`` with other options left the earlier run's figures beside the new
+    metrics.json (a user audit, 2026-11-27): the results of other inputs go first."""
+    rec = write_record(tmp_path / "r.nc")
+    out = tmp_path / "dd"
+    r = run(tmp_path, rec, "--signal", "acc", "--tach", "tach", *SMALL, "-o", out)
+    assert r.returncode == 0, r.stderr
+    assert any((out / "figures").glob("acc_*.png"))
+    r = run(tmp_path, rec, "--signal", "acc", "--tach", "tach", *SMALL, "-o", out, "--force",
+            "--no-figures", "--set", "diagnostics.harmonic=2")
+    assert r.returncode == 0, r.stderr
+    assert not (out / "figures").exists()
+    assert metrics(out)["settings"]["harmonic"] == 2
+    # with figures again: drawn anew
+    r = run(tmp_path, rec, "--signal", "acc", "--tach", "tach", *SMALL, "-o", out, "--force",
+            "--set", "diagnostics.harmonic=2")
+    assert r.returncode == 0 and any((out / "figures").glob("acc_*.png")), r.stderr

@@ -352,8 +352,9 @@ def claim_folder(target: OutputTarget, ident: dict[str, Any], *, force: bool,
     force : bool
         Replace results of other inputs.
     results : list of str
-        Names of the files this command writes (a folder holding one of them without a record is
-        refused unless ``force``).
+        Names of the files and folders this command writes (a folder holding one of them
+        without a record is refused unless ``force``; those of other inputs are removed when
+        this run replaces them, ``"replace"`` and ``"retry"``).
     record : bool
         Write the record (``complete: false``) now; ``False`` for a command that computes
         everything before writing its first file: it calls :func:`begin` just before that.
@@ -386,9 +387,26 @@ def claim_folder(target: OutputTarget, ident: dict[str, Any], *, force: bool,
                               "pass --force to replace them, or choose another output with "
                               "--out")
         state = "replace" if existing else "new"
+    if state in ("replace", "retry"):
+        # the results of other inputs go before this run writes its own: a --force run with
+        # other options left the earlier run's figures beside the new metrics.json (a user
+        # audit, 2026-11-27)
+        _remove_results(folder, results)
     if record:
         begin(target, ident)
     return state
+
+
+def _remove_results(folder: Path, results: list[str]) -> None:
+    """Remove the named results (files or folders) of ``folder`` that exist."""
+    import shutil
+
+    for name in results:
+        p = folder / name
+        if p.is_dir() and not p.is_symlink():
+            shutil.rmtree(p)
+        elif p.exists() or p.is_symlink():
+            p.unlink()
 
 
 def begin(target: OutputTarget, ident: dict[str, Any]) -> None:

@@ -25,7 +25,8 @@ from ._common import (
 DEFAULT_OUT = Path("geardyn-out")
 
 #: Files whose presence (without an inputs record) means a folder holds earlier results.
-RESULTS = ["summary.json", "report.html", "results.nc", "geometry.json", "case.toml"]
+RESULTS = ["summary.json", "report.html", "results.nc", "geometry.json", "case.toml",
+           "figures", "runs", "stiffness_healthy.nc", "stiffness_cracked.nc"]
 
 
 @app.command("run")
