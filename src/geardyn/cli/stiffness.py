@@ -163,6 +163,25 @@ def stiffness(
         t.caption = "* between the map's centre distances: interpolated in the map"
     console.print(t)
     notes = sorted({w for m in maps.values() for w in _map_warnings(m)})
+    from ..dynamics.newmark import _widest_zero_window
+
+    from ..errors import GeardynError
+
+    try:  # where the run will be: the static operating centre distance
+        from ..geometry import static_operating_point
+
+        d_op = static_operating_point(pair, case.motor.torque, case.pinion.bearing_stiffness,
+                                      case.gear.bearing_stiffness).centre_distance_change
+    except GeardynError:
+        d_op = 0.0
+    for name, m in maps.items():  # a fault that leaves no pair in contact: said before a run
+        gap = _widest_zero_window(m, d_op)
+        if gap > 0:
+            notes.append(f"the {name} map is zero over {np.degrees(gap):.3g} deg of pinion "
+                         f"rotation at the static operating centre distance ({d_op * 1e3:+.3f} "
+                         "mm): no tooth pair in contact there (the fault leaves a gap in the "
+                         "mesh); a simulation runs free there and may stop with a runaway mesh "
+                         "deflection")
     for w in notes:
         err_console.print(f"[yellow]note[/yellow]: {w}", highlight=False)
     if not has_crack or has_faults:
