@@ -164,7 +164,6 @@ def stiffness(
     console.print(t)
     notes = sorted({w for m in maps.values() for w in _map_warnings(m)})
     from ..dynamics.newmark import _widest_zero_window
-
     from ..errors import GeardynError
 
     try:  # where the run will be: the static operating centre distance
