@@ -126,6 +126,19 @@ def test_the_simulation_stage_records_the_fault_events(tmp_path, example, teeth,
     assert words.startswith("around a fault event")
     assert f"{s['fault_event_angle_deg']:.1f} deg" in words
     assert f"every {period_deg:.1f} deg" in words
+    # the diagnostics: a gear fault of a 25/31 pair is not located by the pinion's TSA (it
+    # claimed "the fault shows at about 332 deg", an arbitrary number: a user audit)
+    from geardyn.studies.paper import diagnostics_stage
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        diagnostics_stage(case, tmp_path, result)
+    if period_deg == 360.0:
+        assert 0 <= s["crack_angle_deg"] < 360 and "gear_fault_averaged_out" not in s
+    else:
+        assert s["crack_angle_deg"] is None
+        assert f"recurs every {period_deg:.4g} deg of pinion rotation" in \
+            s["gear_fault_averaged_out"]
 
 
 def test_the_caption_says_when_the_figures_are_not_centred_on_an_event():
@@ -155,3 +168,18 @@ def test_the_caption_says_at_which_centre_distance_the_event_angle_is():
     same = fault_event_words({**s, "crack_angle_in_stiffness_deg": 175.34}, True, "cracked",
                              "crack")
     assert "static operating" not in same and "every 360.0 deg" in same
+
+
+def test_the_located_sentence_names_what_the_tsa_can_locate():
+    """Grammar and scope of the summary's sentence: two faults "show"; with a gear fault of an
+    unequal pair only the pinion's faults are located."""
+    from geardyn.studies.paper_report import _located_sentence
+
+    two = load_case(EXAMPLES / "two_faults.toml")
+    assert " show at about 50 deg" in _located_sentence(two, {"crack_angle_deg": 50.0})
+    spall = load_case(EXAMPLES / "spall.toml")
+    assert _located_sentence(spall, {"crack_angle_deg": 170.4}) == (
+        " The fault shows at about 170 deg of pinion rotation (the peak of the narrowband "
+        "envelope).")
+    mixed = {"crack_angle_deg": 12.0, "gear_fault_averaged_out": "..."}
+    assert " The pinion's fault shows at about 12 deg" in _located_sentence(spall, mixed)

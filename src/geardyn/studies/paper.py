@@ -782,6 +782,13 @@ def diagnostics_stage(case: Case, out: Path, result: StudyResult) -> None:
             a = dem.angle[int(np.argmax(dem.envelope))] - dem.angle[0]
             angles.append(math.degrees(a) % 360.0)
     result.summary["crack_angle_deg"] = float(np.median(angles))
+    from .paper_values import fault_gears, gear_fault_averaged_out
+
+    averaged = gear_fault_averaged_out(case)
+    if averaged:  # a gear-side fault is not located by the pinion's TSA: no angle claimed
+        result.summary["gear_fault_averaged_out"] = averaged
+        if "pinion" not in fault_gears(case):
+            result.summary["crack_angle_deg"] = None
     result.summary["crack_angle_by_signal_deg"] = angles
     result.summary["crack_angle_resolution_deg"] = 360.0 / (2 * case.diagnostics.bandwidth + 1)
 

@@ -532,9 +532,10 @@ def report_stage(case: Case, out: Path, result: StudyResult) -> None:
             f"pressure angle is {s.get('operating_pressure_angle_deg', float('nan')):.3f} deg and "
             f"the contact ratio {cr.get('physical', float('nan')):.4f} "
             f"({cr.get('paper_eq8', float('nan')):.4f} by eq. 8 of Xue & Howard)."
-            + (f" The {_fault_word(case)} shows at about {s.get('crack_angle_deg'):.0f} deg of "
-               "pinion rotation (the peak of the narrowband envelope)."
-               if s.get("crack_angle_deg") is not None and _fault_word(case) else "")
+            + (_located_sentence(case, s) if s.get("crack_angle_deg") is not None
+               and _fault_word(case) else "")
+            + (f" Not located in the TSA: {s['gear_fault_averaged_out']}."
+               if s.get("gear_fault_averaged_out") else "")
             + f" {n_check} of {len(checks)} consistency checks pass.")
     if result.quick:
         rep.note("This is a --quick run: shorter records (fewer revolutions averaged)"
@@ -694,6 +695,10 @@ def report_stage(case: Case, out: Path, result: StudyResult) -> None:
     if cm:
         _condition_metrics_section(rep, cm, s.get("condition_metrics_undefined", {}),
                                    (faulty, fault))
+        if s.get("gear_fault_averaged_out"):  # a metric below its healthy value says why
+            rep.note(f"These metrics are of the pinion's TSA: {s['gear_fault_averaged_out']}; "
+                     "they do not measure how well an average over the gear's revolutions "
+                     "would see it.")
     if "measurement" in s:
         _measurement_section(rep, s["measurement"], result, fig, case, (faulty, fault))
 
@@ -792,6 +797,20 @@ def _rows_table(rep: Report, rows: list[dict], ref_label: str) -> None:
     rep.table(["quantity", ref_label, "geardyn", "tolerance", "result", "source", "note"], vrows,
               left_columns=1, left=(3, 5, 6),
               classes=[["", "", "", "", "pass" if r["pass"] else "fail", "", ""] for r in rows])
+
+
+def _located_sentence(case: Case, s: dict) -> str:
+    """Where the narrowband envelope puts the fault: " The fault shows at about 172 deg of
+    pinion rotation (...)."; with a gear fault the pinion's TSA averages out, the pinion's
+    faults only."""
+    word = _fault_word(case)
+    if s.get("gear_fault_averaged_out"):
+        n = sum(1 for f in (case.faults or ()) if (f.gear or "pinion") == "pinion") + int(
+            case.crack is not None and case.crack.active and case.crack.gear == "pinion")
+        word = "pinion's faults" if n > 1 else "pinion's fault"
+    verb = "show" if word.endswith("faults") else "shows"
+    return (f" The {word} {verb} at about {s.get('crack_angle_deg'):.0f} deg of pinion rotation "
+            "(the peak of the narrowband envelope).")
 
 
 def _condition_metrics_section(rep: Report, cm: dict, undefined: dict,

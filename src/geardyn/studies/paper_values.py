@@ -163,6 +163,29 @@ def fault_word(case) -> str:
     return "faults" if n + crack > 1 else "fault"
 
 
+def fault_gears(case) -> set[str]:
+    """The gears ("pinion", "gear") that carry the case's crack and faults."""
+    gears = {str(getattr(f, "gear", "pinion") or "pinion") for f in
+             (getattr(case, "faults", None) or ())}
+    if case.crack is not None and case.crack.active:
+        gears.add(str(case.crack.gear))
+    return gears
+
+
+def gear_fault_averaged_out(case) -> str:
+    """Why the pinion's TSA cannot locate a fault on the gear, or "" where it can (no gear
+    fault, or as many gear teeth as pinion teeth, so the gear's fault recurs once per pinion
+    revolution). The TSA averages over pinion revolutions; a gear fault recurs every
+    ``360 z2 / z1`` deg of pinion rotation, so it falls at another pinion angle each time."""
+    z1, z2 = int(case.pinion.teeth), int(case.gear.teeth)
+    if "gear" not in fault_gears(case) or z1 == z2:
+        return ""
+    return (f"the gear's fault recurs every {360.0 * z2 / z1:.4g} deg of pinion rotation "
+            f"({z2} gear teeth to the pinion's {z1}), so the TSA over pinion revolutions "
+            "averages it over the revolution instead of showing it at one angle; its "
+            "indicators here are those of the pinion's average")
+
+
 def faulty_words(case) -> tuple[str, str]:
     """``(adjective, noun)`` of the faulty state of the report: ("cracked", "crack") when the
     case's fault is its crack alone, else ("faulty", "fault"). summary.json, results.nc and the
