@@ -139,3 +139,19 @@ def test_every_command_names_a_faults_value_as_written_and_its_entry_one_way():
         assert err.value.allowed.startswith(allowed), err.value
     with pytest.raises(InputError, match=r"Allowed keys in faults\[0\]: angle,"):
         load_case(growth, ['faults.0.colour="red"'])
+
+
+def test_show_says_which_field_of_a_fault_set_gave():
+    """``--set faults.0.width`` was shown with the case file as the faults' origin (a user
+    audit, 2026-11-27); ``--set motor.torque`` always said --set."""
+    from pathlib import Path
+
+    spall = str(Path(__file__).resolve().parents[2] / "examples" / "faults" / "spall.toml")
+    r = cli("config", "show", "--config", spall, "--set", 'faults.0.width="4 mm"')
+    assert r.exit_code == 0, r.output
+    faults = tomllib.loads(r.stdout)["faults"]
+    assert faults["origin"] == f"{spall}; faults.0.width from --set"
+    assert faults["source"].endswith("; faults.0.width: --set")
+    assert faults["value"][0]["width"] == "4 mm"
+    r = cli("config", "show", "--config", spall)  # without --set: the file alone
+    assert tomllib.loads(r.stdout)["faults"]["origin"] == spall

@@ -92,6 +92,14 @@ def case_to_display_toml(details: CaseDetails) -> str:
                                  and i < len(written) else None) for i, item in enumerate(value)]
         entry = {"value": shown, **entry, "source": case.provenance.get(key, DEFAULT_SOURCE),
                  "origin": origin.get(key, "default")}
+        if key == "faults":  # a field of an entry set by --set: the list's origin says so
+            # (it named the case file alone for --set faults.0.width, a user audit)
+            inner = sorted(k for k in origin if k.startswith("faults."))
+            if inner:
+                by = "; ".join(f"{k} from {origin[k]}" for k in inner)
+                entry["origin"] = f"{entry['origin']}; {by}"
+                entry["source"] = f"{entry['source']}; " + "; ".join(
+                    f"{k}: {case.provenance.get(k, origin[k])}" for k in inner)
         node = tree
         parts = key.split(".")
         for p in parts[:-1]:
