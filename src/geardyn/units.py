@@ -219,6 +219,20 @@ def _short(text: str, n: int = 60) -> str:
     return text if len(text) <= n else text[: n - 1] + "…"
 
 
+def _dimension_of_root(root: dict[str, float]) -> str | None:
+    """The name of the dimension (of :data:`DIMENSIONS`) whose SI unit has the root units
+    ``root`` (``{"radian": 1}``: an angle), or None."""
+    for name in DIMENSIONS:
+        if name == "dimensionless":
+            continue
+        try:
+            if _target_root(name)[1] == root:
+                return name
+        except Exception:  # noqa: BLE001 - a dimension pint cannot express: not this one
+            continue
+    return None
+
+
 def _a(name: str) -> str:
     return ("an " if name[0] in "aeiou" else "a ") + name
 
@@ -370,6 +384,10 @@ def _parse(value: str, dim: Dimension, field: str, allowed: str) -> float:
     want_angle = t_units.get("radian", 0)
     t_root = {u: p for u, p in t_units.items() if u != "radian"}
     if root != t_root:
+        given = _dimension_of_root({**root, **({"radian": angle} if angle else {})})
+        if given is not None:  # "5 deg" for a length: "'deg' is an angle, not a length"
+            raise InputError(field, value, f"{allowed} ({_short(rest.strip(), 20)!r} is "
+                                           f"{_a(given)}, not {_a(dim.name)})")
         have = " ".join(f"{_BASE_NAMES.get(u, u)}^{p:g}" for u, p in sorted(root.items())) \
             or "no dimension"
         raise InputError(field, value, f"{allowed} (this has units {have}, not {_a(dim.name)})")

@@ -197,3 +197,20 @@ def test_the_everyday_unit_table_is_pints_answer():
         p_factor, p_root = U._pint_target_root(dim)
         assert math.isclose(factor, p_factor, rel_tol=1e-15) and root == p_root, dim
     assert set(U._KNOWN_TARGETS) == set(U.DIMENSIONS)
+
+
+@pytest.mark.parametrize(("text", "dim", "said"), [
+    ("5 deg", "length", "'deg' is an angle, not a length"),
+    ("0.3 rad", "length", "'rad' is an angle, not a length"),
+    ("2 ms", "length", "'ms' is a time, not a length"),
+    ("5 mm", "time", "'mm' is a length, not a time"),
+    ("3 Hz", "torque", "'Hz' is a frequency, not a torque"),
+])
+def test_a_quantity_of_another_kind_is_named_as_such(text, dim, said):
+    """"5 deg" for a length read "(this has units no dimension, not a length)" (a user audit,
+    2026-11-27): an angle's radians are dropped before the comparison."""
+    from geardyn.units import to_si
+
+    with pytest.raises(InputError) as err:
+        to_si(text, dim, "f")
+    assert err.value.allowed.endswith(f"({said})"), err.value.allowed
