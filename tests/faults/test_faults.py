@@ -199,8 +199,12 @@ def test_overlapping_faults_refused(base):
         base.with_overrides({"faults": [SPALL, other]})
     # the [crack] section and a root_crack on the same tooth
     crack = {"type": "root_crack", "tooth": base.crack.tooth, "depth": "1 mm"}
-    with pytest.raises(InputError, match="second root_crack"):
+    with pytest.raises(InputError, match=r"not a second root crack on pinion tooth 11: the "
+                                         r"\[crack\] section already cracks it"):
         base.with_overrides({"crack.enabled": True, "faults": [crack]})
+    with pytest.raises(InputError, match=r"faults\[1\]\.type.*not a second root crack on "
+                                         r"pinion tooth 11: faults\[0\] is one there"):
+        base.with_overrides({"faults": [crack, {**crack, "depth": "2 mm"}]})
     # a spall on the part a breakage removed
     brk = {"type": "breakage", "tooth": 11, "height": "3 mm"}
     with pytest.raises(InputError, match="broken tip"):

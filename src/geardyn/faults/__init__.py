@@ -171,7 +171,9 @@ def _check_pairs(faults: list[Fault], pair) -> None:
             where = f"{f.gear} tooth {f.tooth}"
             clash = None
             if f.kind == e.kind and f.kind in ("root_crack", "breakage"):
-                clash = f"a second {f.kind} on {where} ({e.label} has one)"
+                owner = ("the [crack] section already cracks it (crack.enabled = false, or "
+                         "one of the two)" if e.label == "crack" else f"{e.label} is one there")
+                clash = (f"not a second {f.kind.replace('_', ' ')} on {where}: {owner}")
             elif f.kind == e.kind and _overlap(f.window, e.window):
                 clash = f"a {f.kind} that does not overlap {e.label} on {where} (roll " \
                         f"{e.window[0]:.5g} to {e.window[1]:.5g} rad)"
