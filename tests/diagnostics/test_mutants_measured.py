@@ -104,7 +104,7 @@ def test_the_shaft_speed_of_an_angle_over_its_first_and_last_whole_revolutions()
 
 
 # ------------------------------------------------------------------------------ tooth count
-def _diagnose_orders(orders: dict[int, float]):
+def _diagnose_orders(orders: dict[int, float], **options):
     """diagnose of one revolution-periodic signal, 8 revolutions of 512 samples, given as
     order -> amplitude (cosines); the warnings it gives."""
     theta = np.tile(TH, 8) + 2 * np.pi * np.repeat(np.arange(8), N_REV)
@@ -112,8 +112,34 @@ def _diagnose_orders(orders: dict[int, float]):
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         diagnose({"a": x}, teeth=Z, angle=theta, samples_per_rev=N_REV, harmonic=1,
-                 bandwidth=11)
+                 bandwidth=11, **options)
     return [str(w.message) for w in caught if "strongest order" in str(w.message)]
+
+
+def test_teeth_the_record_states_are_not_doubted(tmp_path):
+    """A worn flank's gap put order 6 far above the mesh order of a geardyn simulation, and
+    diagnose asked whether the pinion has 23 teeth, which the record states (a user audit,
+    2026-11-27): no doubt where the file states the teeth (doubt_teeth=False)."""
+    import xarray as xr
+
+    from geardyn.diagnostics import diagnose_file
+
+    mesh = {Z: 1.0, 2 * Z: 0.5}
+    assert _diagnose_orders({**mesh, 6: 5.0}, doubt_teeth=False) == []
+    assert len(_diagnose_orders({**mesh, 6: 5.0})) == 1
+    theta = np.tile(TH, 8) + 2 * np.pi * np.repeat(np.arange(8), N_REV)
+    x = sum(a * np.cos(k * theta + 0.2 * k) for k, a in {**mesh, 6: 5.0}.items())
+    t = np.arange(theta.size) / 5000.0
+    ds = xr.Dataset({"theta_p": ("time", theta), "v_yg": ("time", x),
+                     "omega_p": ("time", np.gradient(theta, t)),
+                     "transmission_error": ("time", 1e-4 * x)}, coords={"time": t},
+                    attrs={"model": "II", "pinion_teeth": Z})
+    ds.to_netcdf(tmp_path / "sim.nc", engine="h5netcdf")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        diagnose_file(tmp_path / "sim.nc", signals="v_yg", samples_per_rev=N_REV, harmonic=1,
+                      bandwidth=11)
+    assert not [w for w in caught if "strongest order" in str(w.message)]
 
 
 def test_the_tooth_count_warning_needs_three_times_the_mesh_harmonics():

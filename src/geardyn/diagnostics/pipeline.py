@@ -342,6 +342,7 @@ def diagnose(
     units: Mapping[str, str] | None = None,
     source: str = "",
     pwvd_distributions: bool = True,
+    doubt_teeth: bool = True,
 ) -> DiagnosisResult:
     """Run the diagnostics chain on one or more signals sharing a shaft angle.
 
@@ -380,6 +381,11 @@ def diagnose(
         Unit of each signal for labels.
     source : str
         Description of the input (file name) for the report.
+    doubt_teeth : bool
+        Warn when a TSA's strongest order is far above its mesh harmonics and not one of them
+        (a wrong ``teeth``?). :func:`diagnose_file` passes False where the file states the
+        teeth (a simulation result's ``pinion_teeth``, a ``geardyn measure`` record's case):
+        there the strong order is the record's own (a worn flank's gap puts one at order 6).
     pwvd_distributions : bool
         Compute the PWVD distributions (default). False leaves each PWVD's distribution empty,
         shape (0, 0), with its axes and settings (:func:`.tfd.pwvd` ``distribution``); every
@@ -444,7 +450,7 @@ def diagnose(
                         oversampling=t_res.oversampling, method=t_res.method)
         flat = is_constant(avg)
         spectrum = order_spectrum(avg, scaling="rms")
-        if not flat:
+        if not flat and doubt_teeth:
             _warn_if_not_meshing(spectrum, z, name)
         res = residual(avg, teeth=z, preset=residual_preset)
         dem = narrowband_demodulation(avg, teeth=z, harmonic=harmonic, bandwidth=bandwidth,
@@ -683,7 +689,8 @@ def diagnose_file(
     try:
         return diagnose(m.signals, teeth=z, fs=m.fs, time=m.time, angle=m.angle,
                         tach_times=m.tach_times, pulses_per_rev=m.pulses_per_rev,
-                        units=m.units, source=str(path), **options)
+                        units=m.units, source=str(path),
+                        **{"doubt_teeth": m.teeth is None, **options})
     except ShortRecordError as exc:
         raise _short_record(path, m, exc, simulation) from None
     except InputError as exc:

@@ -660,7 +660,8 @@ def _diagnosis_inputs(case: Case, ds) -> dict:
                 samples_per_rev=d.samples_per_rev, harmonic=d.harmonic, bandwidth=d.bandwidth,
                 residual_preset=d.residual_preset,
                 units={"v_yg": "m/s", "omega_p": "rad/s", "transmission_error": "rad"},
-                source=f"geardyn simulation, model {ds.attrs.get('model')}")
+                source=f"geardyn simulation, model {ds.attrs.get('model')}",
+                doubt_teeth=False)  # the case states them (a worn flank's gap: order 6)
 
 
 def _diagnose_run(case: Case, ds):

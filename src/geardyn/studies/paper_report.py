@@ -598,11 +598,15 @@ def report_stage(case: Case, out: Path, result: StudyResult) -> None:
     fig("fig5_stiffness", "Fig. 5a analogue: combined torsional mesh stiffness K_t [N m/rad] "
                           "against pinion rolling angle for centre distance changes 0, 0.5, 1 mm.")
     fig("fig5_load_sharing", "Fig. 5b analogue: load sharing ratio of one tooth pair.")
+    located = s.get("fault_event_angle_deg") is not None
     fig("fig6_crack", "Fig. 6 analogue: healthy (K00) and cracked (KC005, KC105) stiffness."
         if faulty == "cracked" else
         f"Fig. 6 analogue for this case's {fault}: healthy (K00) and {faulty} stiffness at centre "
-        f"distance changes 0 and 1 mm, around the pinion angle where the {faulty} map falls "
-        f"furthest below the healthy one.")
+        "distance changes 0 and 1 mm, "
+        + (f"around the pinion angle where the {faulty} map falls furthest below the healthy "
+           "one." if located else
+           f"not centred on the {fault}: the {faulty} map nowhere falls {FAULT_DIP:.1%} below "
+           "the healthy one."))
 
     # ---------------------------------------------------------------- dynamics
     rep.heading("Dynamics, model I, model I-static and model II (Figs. 8-10)")
