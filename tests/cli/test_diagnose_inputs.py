@@ -266,3 +266,29 @@ def test_force_replaces_the_earlier_figures_too(tmp_path):
     r = run(tmp_path, rec, "--signal", "acc", "--tach", "tach", *SMALL, "-o", out, "--force",
             "--set", "diagnostics.harmonic=2")
     assert r.returncode == 0 and any((out / "figures").glob("acc_*.png")), r.stderr
+
+
+def test_messages_name_the_users_columns(tmp_path):
+    """A user audit (2026-11-27): a flat tach channel blamed --tach-threshold, which was never
+    given; a NaN in the signal was named "signals['acc']"; no --signal said "got None" without
+    the columns to choose from."""
+    t, _, acc, tach = _channels()
+    flat = tmp_path / "flat.csv"
+    np.savetxt(flat, np.column_stack([t, acc, np.zeros_like(t)]), delimiter=",",
+               header="time,acc,tach", comments="")
+    line = one_error(run(tmp_path, flat, "--time", "time", "--signal", "acc", "--tach", "tach",
+                         *SMALL, "-o", tmp_path / "o1"))
+    assert line.startswith("error: --tach: got 'a constant channel (0 throughout)'"), line
+    nan = tmp_path / "nan.csv"
+    acc = acc.copy()
+    acc[500] = np.nan
+    np.savetxt(nan, np.column_stack([t, acc, tach]), delimiter=",", header="time,acc,tach",
+               comments="")
+    line = one_error(run(tmp_path, nan, "--time", "time", "--signal", "acc", "--tach", "tach",
+                         *SMALL, "-o", tmp_path / "o2"))
+    assert line.startswith("error: --signal 'acc': got '1 non-finite value(s), first at index "
+                           "500'"), line
+    line = one_error(run(tmp_path, nan, "--time", "time", "--tach", "tach", *SMALL, "-o",
+                         tmp_path / "o3"))
+    assert line.endswith("allowed: the column(s) to diagnose (name or position): one of "
+                         "'time', 'acc', 'tach'"), line

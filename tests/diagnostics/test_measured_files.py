@@ -329,3 +329,26 @@ def test_decimal_commas_after_whole_number_rows_and_commas_in_names(tmp_path):
     t = read_table(path)
     assert t.names == ["Zeit [s]", "Kraft, axial [N]"]
     assert list(t.columns["Kraft, axial [N]"]) == [1.5, 2.5]
+
+
+def test_a_missing_tach_pulse_is_named_as_such(tmp_path):
+    """One pulse of a regular train missing: it was refused as "2 too soon" with advice to set
+    --tach-min-interval, which did not help (a user audit, 2026-11-27). Chatter keeps its own
+    message (tests/diagnostics/test_mutants_measured.py)."""
+    from geardyn.diagnostics.loading import load_measurement
+
+    t, theta, acc = _record()
+    tach = _pulses(t, theta)
+    turn = np.floor((theta + 0.3) / (2 * np.pi) + 1e-9)
+    tach[turn == 20] = 0.0  # the 20th revolution's pulse is lost
+    path = tmp_path / "miss.csv"
+    np.savetxt(path, np.c_[t, acc, tach], delimiter=",", header="time,acc,tach", comments="",
+               fmt="%.10g")
+    with pytest.raises(InputError) as err:
+        load_measurement(path, signal="acc", time="time", tach="tach")
+    assert err.value.field == "tach"
+    assert err.value.value.endswith("pulses, 1 interval(s) with a pulse missing")
+    assert "2 times the regular interval: about 1 pulse missed" in err.value.allowed
+    # the last pulse before the gap: turn 19 at theta = 2 pi 19, t = (19 + 0.3 / (2 pi)) / 25
+    before = float(err.value.allowed.split("after the pulse at t = ")[1].split(" s")[0])
+    assert before == pytest.approx((19 + 0.3 / (2 * np.pi)) / 25.0, abs=1e-4)

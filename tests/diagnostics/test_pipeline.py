@@ -287,7 +287,8 @@ def test_nan_in_measured_signal_is_reported_by_name(tmp_path, measured):
     path = tmp_path / "gap.csv"
     np.savetxt(path, np.column_stack([v, theta]), delimiter=",", header="vib,angle",
                comments="")
-    with pytest.raises(InputError, match=r"signals\['vib'\]: .*first at index 123"):
+    # the column as diagnose_file's caller names it ("--signal 'vib'" on the command line)
+    with pytest.raises(InputError, match=r"signals 'vib': .*first at index 123"):
         diagnose_file(path, signals="vib", fs=FS, angle="angle", teeth=Z)
 
 

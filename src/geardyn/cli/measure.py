@@ -152,9 +152,10 @@ def measure(
         written.append(str(out.with_suffix(".mat")))
     write_netcdf(ds, out)  # last: the NetCDF with its inputs marks the whole result done
     m = result.measured
+    pulses = m.pulse_times.size
     console.print(f"[green]done[/green]: {m.acc.size} samples at {m.fs:.6g} Hz "
-                  f"({m.acc.size / m.fs:.4g} s), {m.pulse_times.size} tachometer pulses -> "
-                  f"{', '.join(written)}")
+                  f"({m.acc.size / m.fs:.4g} s), {pulses} tachometer "
+                  f"pulse{'' if pulses == 1 else 's'} -> {', '.join(written)}")
     console.print(f"  acceleration RMS {float(m.acc.std()):.4g} m/s^2 "
                   f"({float(m.acc.std()) / 9.80665:.4g} g), noise RMS {m.noise_rms:.4g} m/s^2")
     if m.clipped:
@@ -162,4 +163,10 @@ def measure(
                           f"({100 * m.clipped / m.acc.size:.3g} %): raise measurement.adc_range")
     # the file states its rate, the teeth of the tachometer's shaft and the pulses per
     # revolution: diagnose reads them
-    console.print(f"  diagnose it: geardyn diagnose {out} --signal acc --tach tach")
+    if pulses < 2:  # diagnose needs a revolution between two pulses (a user audit)
+        err_console.print(f"[yellow]warning[/yellow]: {pulses} tachometer "
+                          f"pulse{'' if pulses == 1 else 's'} in the record: diagnose needs at "
+                          "least 2 (a whole revolution of the tachometer's shaft); lengthen "
+                          "simulation.record_time", highlight=False, soft_wrap=True)
+    else:
+        console.print(f"  diagnose it: geardyn diagnose {out} --signal acc --tach tach")

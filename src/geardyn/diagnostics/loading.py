@@ -425,6 +425,26 @@ def _pulse_times(col, *, fs, time, threshold, edge, min_interval, name_of) -> np
         # a speed change (a run-up changes the interval by a small factor from pulse to pulse)
         gaps = np.diff(times)
         neighbour = np.maximum(np.r_[gaps[1], gaps[:-1]], np.r_[gaps[1:], gaps[-2]])
+        # an interval well over its regular neighbours': a pulse missed (the regular intervals
+        # beside it then look "too soon", and --tach-min-interval did not help: a user audit)
+        # (only a few, each of a few intervals, in a train whose other intervals are all within
+        # 30 % of the median: not a run-up, nor chatter, whose short intervals come below)
+        typ = float(np.median(gaps))
+        is_long = gaps > 1.6 * typ
+        if (0 < np.count_nonzero(is_long) <= max(1, gaps.size // 10)
+                and np.all(gaps[is_long] < 10.5 * typ)
+                and np.all(np.abs(gaps[~is_long] / typ - 1) < 0.3)):
+            k = int(np.flatnonzero(is_long)[0])
+            missed = max(1, round(gaps[k] / typ) - 1)
+            raise InputError(
+                name_of("tach"), f"{times.size} pulses, {int(np.count_nonzero(is_long))} "
+                                 "interval(s) with a pulse missing",
+                f"a pulse train without missing pulses (after the pulse at t = {times[k]:.6g} s "
+                f"the next comes {gaps[k]:.4g} s later, {gaps[k] / typ:.3g} times the regular "
+                f"interval: about {missed} pulse{'s' if missed > 1 else ''} missed); lower "
+                f"{name_of('tach_threshold')} (now {tach_threshold_level(col, threshold):.6g}) "
+                "if a pulse is too small to cross it, or diagnose the parts before and after "
+                "the gap as records of their own")
         is_short = gaps < 0.5 * neighbour
         short = int(np.count_nonzero(is_short))
         if short:

@@ -37,7 +37,7 @@ from typing import Any
 
 import numpy as np
 
-from geardyn.errors import DataFileError, InputError
+from geardyn.errors import NOT_GIVEN, DataFileError, GeardynError, InputError
 
 from .demodulation import DemodulationResult, narrowband_demodulation
 from .io import NETCDF_SUFFIXES
@@ -663,9 +663,18 @@ def diagnose_file(
                                  f"it applies to a measured {name_of('tach')} or "
                                  f"{name_of('angle')} channel")
     else:
-        if signals is None:
-            raise InputError(name_of("signals"), None,
-                             "the column(s) to diagnose (name or position)")
+        if signals is None:  # name the columns there are (the file is read for them)
+            from .io import read_table
+
+            try:
+                names = read_table(path).names
+            except GeardynError:
+                names = []
+            shown = ", ".join(repr(n) for n in names[:12]) + (" ..." if len(names) > 12
+                                                              else "")
+            raise InputError(name_of("signals"), NOT_GIVEN,
+                             "the column(s) to diagnose (name or position)"
+                             + (f": one of {shown}" if shown else ""))
         m = load_measurement(path, signal=signals, fs=fs, time=time, angle=angle, tach=tach,
                              tach_column_is_pulse_times=tach_column_is_pulse_times,
                              pulses_per_rev=pulses_per_rev, tach_threshold=tach_threshold,
@@ -732,6 +741,11 @@ def _renamed(exc: InputError, name_of) -> InputError:
     """``exc`` of :func:`diagnose` with its field named as the caller of :func:`diagnose_file`
     knows it (``tach_times`` -> ``tach``, or the command-line option ``--tach``); ``exc`` as it
     is when nothing changes."""
+    import re
+
+    m = re.fullmatch(r"signals\[(['\"])(.*)\1\]", str(exc.field))
+    if m:  # diagnose's signals['acc']: the file's column, as the caller named it
+        return InputError(f"{name_of('signals')} {m.group(2)!r}", exc.value, exc.allowed)
     parts = str(exc.field).split("/")
     field = "/".join(name_of(_FILE_ARGUMENT_OF[p]) if p in _FILE_ARGUMENT_OF else p
                      for p in parts)

@@ -408,6 +408,10 @@ def tach_pulse_times(signal, *, fs: float | None = None, time=None,
     if edge not in ("rising", "falling"):
         raise InputError("edge", edge, "'rising' or 'falling'")
     t = _sample_times(s.shape[0], fs, time)
+    if threshold is None and not s.max() > s.min():  # a flat channel has no pulses to find
+        raise InputError("tach", f"a constant channel ({s.min():.6g} throughout)",
+                         "a tachometer channel with pulses: is it connected, or is it another "
+                         "column?")
     c = tach_threshold(s, threshold)
     if not s.min() < c <= s.max():
         raise InputError("threshold", c, f"a level between the tach minimum {s.min():.6g} and "
