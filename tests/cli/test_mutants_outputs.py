@@ -81,3 +81,18 @@ def test_recorded_inputs_is_a_dict_or_none(tmp_path):
     (tmp_path / "d.nc").write_text("text\n")
     assert recorded_inputs(tmp_path / "d.nc") is None
     assert recorded_inputs(tmp_path / "missing.nc") is None
+
+
+def test_another_input_file_is_named_first_as_another_file():
+    """paper.csv diagnosed into the folder of paper.nc's results was refused for "the content
+    of FILE paper.csv", as if the file had been edited (a user audit, 2026-11-27)."""
+    from geardyn.cli._outputs import differences
+
+    def ident(path, sha, signal):
+        return {"command": "diagnose", "geardyn": "1", "options": {"signal": signal},
+                "files": {"FILE": {"path": path, "sha256": sha}}}
+
+    assert differences(ident("paper.nc", "a", "acc"), ident("paper.csv", "b", "x")) == [
+        "FILE paper.nc -> paper.csv", "signal 'acc' -> 'x'"]
+    assert differences(ident("r.csv", "a", "acc"), ident("r.csv", "b", "acc")) == [
+        "the content of FILE r.csv"]

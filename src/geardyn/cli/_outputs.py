@@ -167,10 +167,17 @@ def differences(old: dict[str, Any], new: dict[str, Any]) -> list[str]:
     diff += [f"{k} {_short(repr(oa.get(k)), 40)} -> {_short(repr(ob.get(k)), 40)}"
              for k in sorted(set(oa) | set(ob)) if oa.get(k) != ob.get(k)]
     fa, fb = old.get("files") or {}, new.get("files") or {}
+    files = []
     for k in sorted(set(fa) | set(fb)):
-        if (fa.get(k) or {}).get("sha256") != (fb.get(k) or {}).get("sha256"):
-            diff.append(f"the content of {k} {_short((fb.get(k) or fa.get(k) or {}).get('path', ''), 60)}")
-    return diff
+        was, now = (fa.get(k) or {}), (fb.get(k) or {})
+        if was.get("sha256") == now.get("sha256"):
+            continue
+        if was.get("path") and now.get("path") and was["path"] != now["path"]:
+            # another file (paper.nc's results, now paper.csv: a user audit), not an edit
+            files.append(f"{k} {_short(was['path'], 40)} -> {_short(now['path'], 40)}")
+        else:
+            files.append(f"the content of {k} {_short((now or was).get('path', ''), 60)}")
+    return files + diff  # another input file first: it explains the rest
 
 
 def _value_differences(key: str, a: Any, b: Any) -> list[str]:
