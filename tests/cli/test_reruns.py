@@ -195,7 +195,7 @@ def test_diagnose_defaults_beside_each_input_and_reruns(tmp_path):
     into_a = run("diagnose", str(tmp_path / "b.csv"), "--out", str(tmp_path / "a-diagnose"),
                  *opts, cache=cache)
     line = _one_error_line(into_a)
-    assert "holds results of different inputs" in line and "the content of FILE" in line
+    assert "holds results of different inputs (FILE " in line and "a.csv -> " in line, line
 
 
 def test_only_an_input_error_marks_a_folder_replaceable(tmp_path):

@@ -25,8 +25,10 @@ from ._common import (
 DEFAULT_OUT = Path("geardyn-out")
 
 #: Files whose presence (without an inputs record) means a folder holds earlier results.
-RESULTS = ["summary.json", "report.html", "results.nc", "geometry.json", "case.toml",
-           "figures", "runs", "stiffness_healthy.nc", "stiffness_cracked.nc"]
+RESULTS = ["summary.json", "report.html", "results.nc", "geometry.json", "case.toml"]
+#: What else a run writes: refused without a record and removed when --force replaces the
+#: results of other inputs, like RESULTS, but not required to call a folder up to date.
+OTHER_RESULTS = ["figures", "runs", "stiffness_healthy.nc", "stiffness_cracked.nc"]
 
 
 @app.command("run")
@@ -88,7 +90,7 @@ def run(
     from ..processes import fe_processes
 
     fe_processes()  # a bad GEARDYN_FE_PROCESSES refused before the output folder is claimed
-    state = claim_folder(target, ident, force=force, results=RESULTS)
+    state = claim_folder(target, ident, force=force, results=RESULTS + OTHER_RESULTS)
     say_state(state, target)
     with (input_errors_recorded(target, ident), progress_bar() as bar,
           record_lookups() as lookups):
