@@ -528,6 +528,8 @@ def simulate(case, stiffness_map: StiffnessMap | None = None, *, model: str | No
         from ..stiffness import build_map
 
         stiffness_map = build_map(case, cracked=cracked)
+    else:
+        _check_family_map(case, stiffness_map, cracked)
     status, fail, static, record = integrate(case, stiffness_map, which, cracked=cracked,
                                              progress=progress)
     if status != K.OK:
@@ -589,6 +591,24 @@ def integrate(case, stiffness_map: StiffnessMap, which: str, *, cracked: bool = 
 
     status, fail = drive_chunks(step, ist, n_last, progress=progress)
     return status, fail, static, record
+
+
+def _check_family_map(case, stiffness_map: StiffnessMap, cracked: bool) -> None:
+    """Refuse a map other than the case's own for a load-family case: with
+    ``stiffness.fe.torques`` the run reads the family's FE maps, built from the case, and a
+    given PEM map was silently replaced by them while the record named the PEM map (a user
+    audit, 2026-11-27)."""
+    if case.stiffness.fe.torques is None or case.stiffness.method != "fe":
+        return
+    from ..cache import cache_key
+    from ..stiffness import map_inputs
+
+    if stiffness_map.attrs.get("inputs_hash") != cache_key(map_inputs(case, "fe", cracked)):
+        raise InputError("stiffness_map", f"a {stiffness_map.attrs.get('method', 'user')} map "
+                         "of other inputs than the case's",
+                         "no map (None) or the case's own FE map: a case with "
+                         "stiffness.fe.torques runs on its load family of FE maps, built from "
+                         "the case (remove the torques to simulate on another map)")
 
 
 def check_arguments(case, stiffness_map, model) -> str:
