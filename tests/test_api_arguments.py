@@ -230,6 +230,16 @@ def test_static_te_refuses_bad_torques(case, kmap, torque):
              "torque")
 
 
+@pytest.mark.parametrize("flag", ["errors", "cracked"])
+@pytest.mark.parametrize("value", ["no", "yes", 1, None])
+def test_static_te_flags_are_booleans(case, kmap, flag, value):
+    """``errors="no"`` was taken as True (a user audit, 2026-11-27)."""
+    _refused(lambda: static_te_of_case(case, 1.0, stiffness_map=kmap, n=16, **{flag: value}),
+             flag)
+    _refused(lambda: static_te_curves(case, 1.0, stiffness_map=kmap, n=16, **{flag: value}),
+             flag)
+
+
 def test_static_te_refuses_what_is_not_a_case(kmap):
     _refused(lambda: static_te_of_case("case", 1.0, stiffness_map=kmap), "case")
 
@@ -301,3 +311,18 @@ def test_diagnose_file_refuses_a_tach_for_a_simulation_record(case, tmp_path):
         with pytest.raises(InputError) as info:
             diagnose_file(rec, **kwargs)
         assert info.value.field == field and "exact pinion angle" in info.value.allowed
+
+
+def test_numpy_scalars_are_the_numbers_they_hold():
+    """A sweep over ``np.arange`` gives NumPy scalars: ``pinion.teeth = np.int64(23)`` was
+    refused as "got 23; allowed: a valid integer" (a user audit, 2026-11-27). Non-integral
+    values are still refused."""
+    import geardyn
+
+    c = geardyn.paper_case({"pinion.teeth": np.int64(25), "motor.torque": np.float32(90.0),
+                            "simulation.decimation": np.int32(2)})
+    assert (c.pinion.teeth, c.motor.torque, c.simulation.decimation) == (25, 90.0, 2)
+    assert type(c.pinion.teeth) is int
+    again = geardyn.paper_case().with_overrides({"pinion.teeth": np.int64(25)})
+    assert again.pinion.teeth == 25 and type(again.pinion.teeth) is int
+    _refused(lambda: geardyn.paper_case({"pinion.teeth": np.float64(25.5)}), "pinion.teeth")

@@ -193,6 +193,10 @@ def static_te_of_case(case, torque: float | None = None, *, cracked: bool = Fals
     values; anything else raises :class:`geardyn.errors.InputError` naming the argument.
     """
     _check_case(case)
+    from .errors import check_flag
+
+    cracked = check_flag(cracked, "cracked")
+    errors = check_flag(errors, "errors")  # "no" was taken as True (a user audit)
     if torque is not None:  # refused by name before a map is built
         torque = _quantity(torque, "torque", "torque")
     if stiffness_map is None:
@@ -227,6 +231,10 @@ def static_te_curves(case, torque: float | None = None, *, cracked: bool = False
     from .config import case_to_toml
 
     _check_case(case)
+    from .errors import check_flag
+
+    cracked = check_flag(cracked, "cracked")
+    errors = check_flag(errors, "errors")
     if torque is not None:
         torque = _quantity(torque, "torque", "torque")
     centre_distance_change = _quantity(centre_distance_change, "length", "centre_distance_change")

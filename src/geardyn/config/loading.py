@@ -421,7 +421,24 @@ def _overrides_dict(overrides: Iterable[str] | Mapping[str, Any] | str) -> dict[
     for key in overrides:
         if not isinstance(key, str):
             raise InputError("overrides", key, "dotted keys (strings) such as 'pinion.teeth'")
-    return dict(overrides)
+    return {k: _plain_value(v) for k, v in overrides.items()}
+
+
+def _plain_value(value: Any) -> Any:
+    """NumPy scalars and arrays as the Python numbers and lists they hold: a loop over
+    ``np.arange`` gives ``np.int64`` teeth, which the strict integer fields refused ("got 23;
+    allowed: a valid integer", a user audit, 2026-11-27)."""
+    import numpy as np
+
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, list | tuple):
+        return type(value)(_plain_value(v) for v in value)
+    if isinstance(value, dict):
+        return {k: _plain_value(v) for k, v in value.items()}
+    return value
 
 
 def _format_validation_error(exc: ValidationError, data: Mapping[str, Any]) -> InputError:
