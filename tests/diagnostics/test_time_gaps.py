@@ -54,3 +54,24 @@ def test_one_dropped_sample_and_jitter_pass():
     assert tsa(X, time=T + jitter, tach_times=TACH, samples_per_rev=512).n_averages >= 17
     run_up = 2 * np.pi * 30.0 * T**2  # from standstill to 60 rev/s in 1 s
     assert tsa(np.sin(23 * run_up), angle=run_up, time=T, samples_per_rev=512).n_averages >= 10
+
+
+@pytest.mark.parametrize("fs", [-1e5, 0, float("nan"), "x", True])
+def test_a_bad_rate_beside_an_angle_is_refused(fs):
+    """With an angle, ``fs`` only times the record: a string failed deep in numpy, a negative
+    rate passed and the speed vanished silently (a user audit, 2026-11-27)."""
+    with pytest.raises(InputError) as err:
+        tsa_input = {"v": X[:4096]}
+        from geardyn.diagnostics import diagnose
+
+        diagnose(tsa_input, teeth=23, angle=ANGLE[:4096], fs=fs, samples_per_rev=256)
+    assert err.value.field == "fs"
+
+
+def test_a_rate_with_a_unit_beside_an_angle_times_the_record():
+    from geardyn.diagnostics import diagnose
+
+    a = diagnose({"v": X}, teeth=23, angle=ANGLE, fs="25.6 kHz", samples_per_rev=256)
+    b = diagnose({"v": X}, teeth=23, angle=ANGLE, fs=FS, samples_per_rev=256)
+    assert a.settings["shaft_speed_rev_s"] == b.settings["shaft_speed_rev_s"]
+    assert a.settings["shaft_speed_rev_s"]["mean"] == pytest.approx(18.17, rel=1e-9)

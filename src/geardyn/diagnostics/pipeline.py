@@ -406,6 +406,16 @@ def diagnose(
         raise InputError("signals", type(signals).__name__,
                          "a non-empty mapping of name -> 1-D array")
     z = _check_int(teeth, "teeth", 1, "a positive integer number of teeth")
+    if isinstance(fs, str):  # "100 kHz", as diagnose_file and the command line take it
+        from ..units import parse_frequency
+
+        fs = parse_frequency(fs, "fs")
+    if fs is not None and not (isinstance(fs, int | float | np.integer | np.floating)
+                               and not isinstance(fs, bool) and math.isfinite(fs) and fs > 0):
+        # checked on every path: with an angle it only times the record (the shaft speed), and
+        # a string, a negative or a zero rate failed there or passed silently (a user audit)
+        raise InputError("fs", fs, "a positive finite sample rate in Hz (a number, or a string "
+                                   "with a unit such as '20 kHz')")
     if pwvd_max_order is not None and not (isinstance(pwvd_max_order, int | float)
                                            and not isinstance(pwvd_max_order, bool)
                                            and math.isfinite(pwvd_max_order)
