@@ -183,3 +183,36 @@ def test_the_located_sentence_names_what_the_tsa_can_locate():
         "envelope).")
     mixed = {"crack_angle_deg": 12.0, "gear_fault_averaged_out": "..."}
     assert " The pinion's fault shows at about 12 deg" in _located_sentence(spall, mixed)
+
+
+def test_a_failed_location_check_is_not_a_location():
+    """The tooth-error example's envelope peaked 17.5 deg from the crack (check failed) and the
+    summary still said "the crack shows at about 196 deg" (a user audit, 2026-11-27)."""
+    from geardyn.studies.paper_report import _located_sentence, location_check_failed
+
+    case = geardyn.paper_case()
+    row = {"quantity": "crack seen in the TSA: offset from where the cracked map is weakest "
+                       "[deg]", "geardyn": 17.49, "tolerance": 15.652, "pass": False}
+    s = {"crack_angle_deg": 195.56, "checks": [row]}
+    assert location_check_failed(s) is row
+    text = _located_sentence(case, s)
+    assert "shows at" not in text and "it does not locate the crack here" in text
+    assert "peaks at about 196 deg" in text and "17.5 deg from" in text and "15.7 deg" in text
+    s["checks"] = [{**row, "pass": True}]
+    assert location_check_failed(s) is None
+    assert _located_sentence(case, s).startswith(" The crack shows at about 196 deg")
+
+
+def test_the_healthy_baseline_with_tooth_errors_is_real():
+    """NA4* was "undefined" for the tooth-error example because its healthy map repeats every
+    mesh cycle, though its healthy record holds ISO class-6 errors (a user audit)."""
+    from geardyn.studies.paper import _healthy_teeth_differ
+
+    assert not _healthy_teeth_differ(geardyn.paper_case())
+    assert _healthy_teeth_differ(load_case(EXAMPLES.parent / "tooth_errors" / "case.toml"))
+    relief = geardyn.paper_case({"modifications.pinion.tip_relief": "10 um",
+                                 "modifications.gear.tip_relief": "10 um"})
+    assert not _healthy_teeth_differ(relief)  # every tooth alike: still mesh-periodic
+    assert _healthy_teeth_differ(geardyn.paper_case({"modifications.pinion.runout": "5 um"}))
+    # the faults' wear is the faulty pair's, not the healthy one's
+    assert not _healthy_teeth_differ(load_case(EXAMPLES / "wear.toml"))

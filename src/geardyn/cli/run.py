@@ -116,6 +116,8 @@ def _print_summary(s: dict, out: Path, lookups: list | None = None) -> None:
     from rich.markup import escape
     from rich.table import Table
 
+    from ..studies.paper_report import location_check_failed
+
     from ._outputs import say_cache
 
     # a case whose physical inputs differ from the paper's is compared with nothing (as in
@@ -134,7 +136,7 @@ def _print_summary(s: dict, out: Path, lookups: list | None = None) -> None:
             ("mean pinion speed \\[rad/s]", s.get("mean_pinion_speed_rad_s"), "114.14"),
             ("mean transmission error \\[rad]", s.get("mean_transmission_error_rad"), "0.05"),
             ("crack seen at \\[deg]" if paper else "fault seen at \\[deg]",
-             s.get("crack_angle_deg"), "~170")]
+             None if location_check_failed(s) else s.get("crack_angle_deg"), "~170")]
     for label, ours, theirs in rows:
         if ours is None:
             continue
@@ -156,6 +158,13 @@ def _print_summary(s: dict, out: Path, lookups: list | None = None) -> None:
     for v in failed:
         err_console.print(f"[yellow]outside tolerance[/yellow]: {escape(v['quantity'])}: "
                           f"geardyn {v['geardyn']:.4g}, paper {v['paper']:.4g}")
+    for v in s.get("checks", []):  # a failed consistency check is said too (it was not)
+        if not v.get("pass"):
+            err_console.print(f"[yellow]consistency check failed[/yellow]: "
+                              f"{escape(str(v['quantity']))}: geardyn {v['geardyn']:.4g}, "
+                              f"expected {v.get('reference', float('nan')):.4g} "
+                              f"{escape(str(v.get('tolerance_text', '')))} (see the report)",
+                              highlight=False, soft_wrap=True)
     cmp = s.get("model_comparison", {}).get("cracked", {}).get("signals", {})
     ratios = {k: [v[k] for v in cmp.values() if v.get(k) is not None]
               for k in ("rms_ii_minus_i_static", "rms_ii_minus_i", "explained_fraction")}

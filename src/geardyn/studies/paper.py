@@ -701,6 +701,17 @@ def paper_tables(cracked: dict) -> tuple[dict, dict]:
     return t2, t3
 
 
+def _healthy_teeth_differ(case: Case) -> bool:
+    """Whether the healthy pair's teeth differ from one another: per-tooth errors (pitch,
+    slope, form) or runout of the case's ``[modifications]`` (a tip relief on every tooth
+    alike keeps the mesh period; the faults' wear is not the healthy pair's)."""
+    from ..faults import without_faults
+    from ..modifications import ToothModifications
+
+    m = ToothModifications.from_case(without_faults(case))
+    return m.has_runout or m.pinion.has_table or m.gear.has_table
+
+
 def healthy_baseline_is_periodic(healthy_map, rtol: float = 1e-6) -> bool:
     """Whether every mesh cycle of the healthy map is the same (all teeth alike, no tooth errors).
 
@@ -794,7 +805,11 @@ def diagnostics_stage(case: Case, out: Path, result: StudyResult) -> None:
     result.summary["crack_angle_resolution_deg"] = 360.0 / (2 * case.diagnostics.bandwidth + 1)
 
     # healthy vs cracked condition metrics (NA4* with the healthy residual as baseline)
-    periodic = healthy_baseline_is_periodic(result.maps["healthy"])
+    # the healthy record repeats every mesh period only if its map does and its teeth are all
+    # alike: tooth errors or runout (the healthy pair keeps them) make a real baseline (the
+    # tooth-error example's NA4* was "undefined" for teeth "all alike": a user audit)
+    periodic = (healthy_baseline_is_periodic(result.maps["healthy"])
+                and not _healthy_teeth_differ(case))
     detect: dict = {}
     # model I-static too (geardyn's addition): whether a metric sees the fault without model
     # II's iteration is the question the model study asks

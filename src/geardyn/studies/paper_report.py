@@ -710,8 +710,11 @@ def report_stage(case: Case, out: Path, result: StudyResult) -> None:
     rep.heading("Consistency checks (not validation)")
     rep.paragraph(
         "Quantities fixed by the inputs, the geometry, the static torque balance or a "
-        "calibration. A failure here means broken plumbing; a pass says nothing about the "
-        "mesh stiffness or the dynamics, so these rows are not counted as validation.")
+        "calibration. A failure here means broken plumbing, except the offset of the fault "
+        "seen in the TSA: that one fails where other modulation (tooth errors, another fault) "
+        "outweighs the fault's in the envelope, and the envelope's peak then does not locate "
+        "it. A pass says nothing about the mesh stiffness or the dynamics, so these rows are "
+        "not counted as validation.")
     _rows_table(rep, checks, "expected")
     if paper:
         rep.heading("Comparisons with the paper")
@@ -803,10 +806,27 @@ def _rows_table(rep: Report, rows: list[dict], ref_label: str) -> None:
               classes=[["", "", "", "", "pass" if r["pass"] else "fail", "", ""] for r in rows])
 
 
+def location_check_failed(s: dict) -> dict | None:
+    """The consistency check of the fault's angle in the TSA (its offset from where the faulty
+    map is weakest) when it failed, else None."""
+    for row in s.get("checks", []):
+        if "seen in the TSA: offset" in str(row.get("quantity", "")) and not row.get("pass"):
+            return row
+    return None
+
+
 def _located_sentence(case: Case, s: dict) -> str:
     """Where the narrowband envelope puts the fault: " The fault shows at about 172 deg of
     pinion rotation (...)."; with a gear fault the pinion's TSA averages out, the pinion's
-    faults only."""
+    faults only; where the location check failed, the peak and why it is not the fault's (it
+    claimed the crack "shows at about 196 deg" beside its own failed check: a user audit)."""
+    failed = location_check_failed(s)
+    if failed is not None:
+        return (f" The narrowband envelope peaks at about {s.get('crack_angle_deg'):.0f} deg of "
+                f"pinion rotation, {abs(float(failed['geardyn'])):.1f} deg from where the faulty "
+                f"map is weakest (more than the envelope's resolution, +/- "
+                f"{float(failed['tolerance']):.1f} deg): it does not locate the "
+                f"{_fault_word(case)} here (see the consistency checks).")
     word = _fault_word(case)
     if s.get("gear_fault_averaged_out"):
         n = sum(1 for f in (case.faults or ()) if (f.gear or "pinion") == "pinion") + int(
@@ -873,9 +893,13 @@ def _measurement_section(rep: Report, m: dict, result: StudyResult, fig, case: C
         return
     rec = m["records"].get("errors+noise|healthy", {})
     secs = result.seconds.get("measurement")
+    # a case with its own tooth errors: the simulation stage's records hold them (the text
+    # said "perfect teeth" for the tooth-error example: a user audit, 2026-11-27)
+    own = str(m.get("errors", "")).startswith("the case's own")
     rep.paragraph(
-        "The tables above use noise-free state velocities of perfect teeth and the exact shaft "
-        "angle. Here the same indicators (Table 2's shape statistics, Table 3's kurtoses, the "
+        "The tables above use noise-free state velocities of "
+        + ("the case's teeth (with its own errors)" if own else "perfect teeth")
+        + " and the exact shaft angle. Here the same indicators (Table 2's shape statistics, Table 3's kurtoses, the "
         f"condition metrics) are computed for model {m['model']} on what a condition-monitoring "
         f"engineer records: the {m['signal']}, through the case's transfer path "
         f"({m['chain']}). Four variants separate the inputs: 'ideal' (perfect teeth; no "
@@ -884,8 +908,10 @@ def _measurement_section(rep: Report, m: dict, result: StudyResult, fig, case: C
         f"Each record is {rec.get('record_s', float('nan')):.3g} s at "
         f"{rec.get('fs_Hz', float('nan')):.6g} Hz ({rec.get('revolutions', 0)} revolutions "
         "averaged; the simulated records less the chain's lead-in and tail). The records "
-        "without errors are the simulation stage's; the two with errors are extra cached "
-        "simulations of the same length"
+        + ("with errors are the simulation stage's; the two without are extra cached "
+           if own else "without errors are the simulation stage's; the two with errors are "
+           "extra cached ")
+        + "simulations of the same length"
         + (f"; this stage took {secs:.1f} s." if secs is not None else "."))
     if m.get("undefined", {}).get("ideal"):
         rep.note("On the ideal record the healthy residual is numerical remainder (all teeth "
