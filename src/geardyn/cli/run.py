@@ -117,7 +117,6 @@ def _print_summary(s: dict, out: Path, lookups: list | None = None) -> None:
     from rich.table import Table
 
     from ..studies.paper_report import location_check_failed
-
     from ._outputs import say_cache
 
     # a case whose physical inputs differ from the paper's is compared with nothing (as in
