@@ -899,7 +899,8 @@ def _measurement_section(rep: Report, m: dict, result: StudyResult, fig, case: C
     rep.paragraph(
         "The tables above use noise-free state velocities of "
         + ("the case's teeth (with its own errors)" if own else "perfect teeth")
-        + " and the exact shaft angle. Here the same indicators (Table 2's shape statistics, Table 3's kurtoses, the "
+        + " and the exact shaft angle. Here the same indicators (Table 2's shape statistics, "
+        "Table 3's kurtoses, the "
         f"condition metrics) are computed for model {m['model']} on what a condition-monitoring "
         f"engineer records: the {m['signal']}, through the case's transfer path "
         f"({m['chain']}). Four variants separate the inputs: 'ideal' (perfect teeth; no "
