@@ -24,6 +24,7 @@ import contextlib
 import hashlib
 import json
 import os
+import time
 from collections.abc import Callable
 from pathlib import Path
 from typing import TypeVar
@@ -188,7 +189,7 @@ class Cache:
                 if self.valid(path, key):
                     try:
                         obj = load(path)
-                        _note_lookup(kind, key, True)
+                        _note_lookup(kind, key, True, path)
                         _touch(path)
                         return obj, True
                     except Exception:  # unreadable despite checksum (format change), or its
@@ -249,7 +250,7 @@ class Cache:
                 self.store(None, path, key, lambda _obj, tmp: write(tmp))
             with atomic_path(target, suffix=target.suffix) as tmp:
                 shutil.copyfile(path, tmp)
-        _note_lookup(kind, key, hit)
+        _note_lookup(kind, key, hit, path)
         return hit
 
     def store(self, obj: object, path: Path, key: str, save: Callable[[object, Path], None]) -> None:
@@ -271,12 +272,24 @@ class Cache:
 
 
 #: Active lookup recorders (see :func:`record_lookups`); each is a list of dicts.
-_RECORDERS: list[list[dict]] = []
+_RECORDERS: list[tuple[list[dict], float]] = []  # (lookups, wall time the block began)
 
 
-def _note_lookup(kind: str, key: str, hit: bool) -> None:
-    for rec in _RECORDERS:
-        rec.append({"kind": kind, "key": key, "hit": hit})
+def _note_lookup(kind: str, key: str, hit: bool, path: Path | None = None) -> None:
+    """Record a lookup in every :func:`record_lookups` block. A hit on an entry written after
+    the block began was computed during it, by another process (the FE bodies' second process)
+    or an earlier lookup: recorded as built (a cold run reported "fe 4 reused", a user audit of
+    2026-11-27)."""
+    written = None
+    if hit and path is not None:
+        try:
+            written = path.with_name(path.name + ".sha256").stat().st_mtime
+        except OSError:
+            written = None
+    for rec, began in _RECORDERS:
+        fresh = hit and written is not None and written >= began
+        rec.append({"kind": kind, "key": key, "hit": hit and not fresh,
+                    **({"built_during_run": True} if fresh else {})})
 
 
 @contextlib.contextmanager
@@ -284,15 +297,17 @@ def record_lookups():
     """Collect this process's :meth:`Cache.get_or_build` lookups while the block runs.
 
     Yields a list that receives one ``{"kind", "key", "hit"}`` dict per lookup (``hit`` is True
-    when the entry was loaded from the cache, False when it was built). The command-line tool
+    when the entry was loaded from the cache as it was before the block began, False when it
+    was built, here or, during the block, by another process: ``built_during_run``). The command-line tool
     writes it into its output folder's ``inputs.json``, so a re-run shows what it reused.
     """
     rec: list[dict] = []
-    _RECORDERS.append(rec)
+    entry = (rec, time.time())
+    _RECORDERS.append(entry)
     try:
         yield rec
     finally:
-        _RECORDERS.remove(rec)
+        _RECORDERS.remove(entry)
 
 
 def default_cache() -> Cache:

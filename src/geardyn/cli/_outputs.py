@@ -453,9 +453,15 @@ def mark_complete(target: OutputTarget, ident: dict[str, Any], lookups: list[dic
 def cache_summary(lookups: list[dict]) -> dict[str, Any]:
     """Cache hits and builds by kind, from :func:`geardyn.cache.record_lookups`."""
     out: dict[str, Any] = {}
+    # each entry once: built if it was computed during the run (by this process or another),
+    # else reused; a map read three times is not three reuses
+    entries: dict[tuple[str, str], bool] = {}
     for item in lookups:
-        k = out.setdefault(item["kind"], {"hits": 0, "built": 0})
-        k["hits" if item["hit"] else "built"] += 1
+        k = (item["kind"], item["key"])
+        entries[k] = entries.get(k, True) and bool(item["hit"])
+    for (kind, _), hit in entries.items():
+        k = out.setdefault(kind, {"hits": 0, "built": 0})
+        k["hits" if hit else "built"] += 1
     return out
 
 
