@@ -326,3 +326,23 @@ def test_numpy_scalars_are_the_numbers_they_hold():
     again = geardyn.paper_case().with_overrides({"pinion.teeth": np.int64(25)})
     assert again.pinion.teeth == 25 and type(again.pinion.teeth) is int
     _refused(lambda: geardyn.paper_case({"pinion.teeth": np.float64(25.5)}), "pinion.teeth")
+
+
+def test_a_case_hashes_as_its_values():
+    """``hash(case)`` raised "unhashable type: 'list'" (pydantic's frozen hash over the list
+    fields), so a case could not key a dict or an lru_cache (a user audit, 2026-11-27)."""
+    import functools
+
+    import geardyn
+
+    a, b = geardyn.paper_case(), geardyn.paper_case()
+    assert a == b and hash(a) == hash(b) and len({a, b}) == 1
+    c = a.with_overrides({"motor.torque": "90 N m"})
+    assert c != a and hash(c) != hash(a)
+
+    @functools.lru_cache
+    def torque(case):
+        return case.motor.torque
+
+    assert torque(a) == torque(b) == 100.0 and torque.cache_info().hits == 1
+    assert hash(a.measurement) == hash(b.measurement)  # a section with list fields

@@ -90,6 +90,17 @@ QuadraticCoefficient = _quantity("quadratic torque coefficient")
 class _Model(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True, validate_default=True)
 
+    @classmethod
+    def __pydantic_init_subclass__(cls, **kwargs):
+        super().__pydantic_init_subclass__(**kwargs)
+        cls.__hash__ = _Model._value_hash  # pydantic's frozen hash fails on list fields
+
+    def _value_hash(self) -> int:
+        """Hash of the values as JSON (equal models, equal hashes): a case can key a dict or an
+        ``lru_cache`` (pydantic's hash of a frozen model raised "unhashable type: 'list'" for
+        the list fields of a case, a user audit of 2026-11-27)."""
+        return hash((type(self).__qualname__, self.model_dump_json()))
+
 
 # --------------------------------------------------------------------------- sections
 class PairConfig(_Model):
