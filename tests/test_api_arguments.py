@@ -346,3 +346,13 @@ def test_a_case_hashes_as_its_values():
 
     assert torque(a) == torque(b) == 100.0 and torque.cache_info().hits == 1
     assert hash(a.measurement) == hash(b.measurement)  # a section with list fields
+
+
+def test_an_entry_of_an_empty_list_says_the_list_is_empty():
+    """"allowed: an index in [0, -1] of the list" for faults.0.width on a case without faults (a
+    user audit, 2026-11-27)."""
+    import geardyn
+
+    err = _refused(lambda: geardyn.paper_case().with_overrides({"faults.0.width": "3 mm"}),
+                   "faults.0")
+    assert "an entry of faults, which is empty in this case" in err.allowed

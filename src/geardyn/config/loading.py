@@ -340,8 +340,13 @@ def _set_dotted(data: dict, key: str, value: Any) -> None:
     for i, p in enumerate(parts[:-1]):
         if isinstance(node, list):  # an entry of a list of tables: faults.0.depth
             if not p.isdigit() or int(p) >= len(node):
+                where = ".".join(parts[:i])
                 raise InputError(".".join(parts[: i + 1]), key,
-                                 f"an index in [0, {len(node) - 1}] of the list")
+                                 f"an index in [0, {len(node) - 1}] of the list"
+                                 if node else
+                                 f"an entry of {where}, which is empty in this case: give the "
+                                 f"whole list ({where} = [...], or [[{where}]] tables in a "
+                                 "case file) before setting one of its fields")
             node = node[int(p)]
             continue
         nxt = node.get(p)
