@@ -536,7 +536,7 @@ def test_tsa_input_texts():
     e = _err(tsa, np.cos(theta), samples_per_rev=64)
     assert (e.field, e.value) == ("angle/tach_times", "neither")
     e = _err(tsa, np.cos(theta[:-1]), angle=theta, samples_per_rev=64)
-    assert (e.field, e.value, e.allowed) == ("angle", "192 samples", "191 samples, like x")
+    assert (e.field, e.value, e.allowed) == ("angle", "192 samples", "191 samples, like the signal(s) (x)")
     e = _err(tsa, np.cos(theta[:3]), angle=theta[:3], samples_per_rev=64)
     assert (e.field, e.allowed) == ("x", "at least 4 samples along the last axis")
     e = _err(tsa, np.ones((2, 2, 8)), angle=theta[:8], samples_per_rev=64)

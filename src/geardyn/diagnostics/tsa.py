@@ -698,7 +698,8 @@ def tsa(
     if angle is not None:
         ang = _as_float_array(angle, "angle", min_size=4)
         if ang.shape[0] != n:
-            raise InputError("angle", f"{ang.shape[0]} samples", f"{n} samples, like the signal(s) (x)")
+            raise InputError("angle", f"{ang.shape[0]} samples",
+                             f"{n} samples, like the signal(s) (x)")
         ang, d = _check_angle(ang, "angle", unwrap)
         if time is not None:  # the sample times beside the angle: a gap in them is one here
             _sample_times(n, fs, time)
