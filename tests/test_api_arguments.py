@@ -356,3 +356,17 @@ def test_an_entry_of_an_empty_list_says_the_list_is_empty():
     err = _refused(lambda: geardyn.paper_case().with_overrides({"faults.0.width": "3 mm"}),
                    "faults.0")
     assert "an entry of faults, which is empty in this case" in err.allowed
+
+
+def test_maps_and_diagnoses_print_as_one_line(kmap):
+    """Their dataclass reprs printed every array (6,800 and 10,000 characters: a user audit)."""
+    import geardyn
+
+    text = repr(kmap)
+    assert text.startswith("StiffnessMap(method=") and len(text) < 300 and "\n" not in text
+    assert f"{kmap.dd.size} centre distance changes" in text and "N/m)" in text
+    th = np.linspace(0.0, 2 * np.pi * 10, 20_000)
+    d = geardyn.diagnose({"v": np.cos(23 * th)}, teeth=23, angle=th, samples_per_rev=256)
+    text = repr(d)
+    assert text.startswith("DiagnosisResult(teeth=23") and len(text) < 300
+    assert "v (10 revolutions" in text

@@ -212,6 +212,16 @@ class DiagnosisResult:
     source: str = ""
     settings: dict = field(default_factory=dict)
 
+    def __repr__(self) -> str:
+        """A line a notebook can show: the signals, their averages and kurtoses (the
+        dataclass's repr printed every array, 10,000 characters: a user audit)."""
+        sig = ", ".join(f"{k} ({v.tsa.n_averages} revolutions, kurtosis "
+                        f"{v.statistics.kurtosis:.4g}"
+                        f", residual {v.residual_kurtosis:.4g})" for k, v in self.signals.items())
+        return (f"DiagnosisResult(teeth={self.teeth}, method={self.method!r}, "
+                f"samples_per_rev={self.samples_per_rev}, signals: {sig}"
+                + (f", source={self.source!r}" if self.source else "") + ")")
+
     def to_dict(self) -> dict:
         """All metrics and settings as a JSON-serialisable dict (NaN/inf as None)."""
         return {

@@ -460,6 +460,17 @@ class StiffnessMap:
         """Combined torsional mesh stiffness ``K_t = k_mb r_b1^2`` [N m/rad]."""
         return np.asarray(self(theta, dd)) * self.base_radius ** 2
 
+    def __repr__(self) -> str:
+        """A line a notebook can show (the dataclass's repr printed every array, 6,800
+        characters: a user audit): method, grid, stiffness range [N/m] and the fault state."""
+        k = np.asarray(self.k_mb, float)
+        dd = np.asarray(self.dd, float) * 1e3
+        return (f"StiffnessMap(method={self.attrs.get('method', '?')!r}, "
+                f"faulty={bool(self.attrs.get('cracked', self.attrs.get('faulty', 0)))}, "
+                f"{dd.size} centre distance "
+                f"changes {dd[0]:+.4g}..{dd[-1]:+.4g} mm, {self.n_cycles} mesh cycles x "
+                f"{2 * self.n_seg} nodes, k_mb {k.min():.4g}..{k.max():.4g} N/m)")
+
     def covers(self, dd: float) -> bool:
         """Whether ``dd`` [m] lies inside the map's centre-distance range."""
         if self.dd.size == 1:
