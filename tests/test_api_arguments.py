@@ -370,3 +370,10 @@ def test_maps_and_diagnoses_print_as_one_line(kmap):
     text = repr(d)
     assert text.startswith("DiagnosisResult(teeth=23") and len(text) < 300
     assert "v (10 revolutions" in text
+
+
+def test_every_variable_of_a_map_dataset_has_a_unit(kmap):
+    """``node`` and ``slot_tooth`` had none (a user audit, 2026-11-27)."""
+    ds = kmap.to_dataset()
+    missing = [n for n, v in {**ds.data_vars, **ds.coords}.items() if "units" not in v.attrs]
+    assert missing == []

@@ -505,7 +505,8 @@ class StiffnessMap:
             coords={
                 "centre_distance_change": ("centre_distance_change", self.dd,
                                            {"units": "m", "long_name": "d' - d"}),
-                "node": ("node", np.arange(nodes), {"long_name": "boundary-fitted node index"}),
+                "node": ("node", np.arange(nodes), {"units": "1",
+                                                    "long_name": "boundary-fitted node index"}),
                 "theta": (("centre_distance_change", "node"), self.node_theta(),
                           {"units": "rad", "long_name": "pinion angle of the node"}),
             },
@@ -528,7 +529,8 @@ class StiffnessMap:
             ds[name] = (dims, v, {"units": u, "long_name": ln})
         if self.slot_tooth is not None:
             ds["slot_tooth"] = (("cycle", "slot"), self.slot_tooth,
-                                {"long_name": "pinion tooth of each load-share slot"})
+                                {"units": "1",
+                                 "long_name": "pinion tooth of each load-share slot"})
         # NetCDF attributes cannot hold containers, booleans or None: store those as JSON text
         ds.attrs.update({k: (json.dumps(v) if isinstance(v, dict | list | tuple | bool)
                              or v is None else v)
