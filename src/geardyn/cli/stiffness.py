@@ -139,13 +139,17 @@ def stiffness(
             fig.savefig(tmp, dpi=150, format="png")
         written.append(fname)
 
+    from rich.markup import escape
     from rich.table import Table
 
     pair = case.gear_pair()
-    t = Table(title=f"{case.name}: {method} mesh stiffness over one revolution")
+    t = Table(title=f"{case.name}: {method} mesh stiffness over one revolution", pad_edge=False)
+    # headers escaped ("[mm]" is rich markup: the unit vanished) and numbers never cut
+    # ("1.258e+..." in an 80-column pipe: a user audit, 2026-11-27)
     for col in ("map", "dd [mm]", "contact ratio", "mean K_t [N m/rad]", "min K_t [N m/rad]",
                 "max K_t [N m/rad]", "mean k_mb [N/m]"):
-        t.add_column(col, justify="right")
+        t.add_column(escape(col), justify="right", min_width=7 if col in ("map", "dd [mm]")
+                     else 9, overflow="fold")
     th = np.linspace(0.0, maps["healthy"].period, 4096, endpoint=False)
     between = False
     for name, m in maps.items():
