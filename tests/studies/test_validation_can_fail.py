@@ -62,7 +62,7 @@ def test_halving_the_mesh_stiffness_fails_a_paper_comparison(nominal_and_half):
     assert newly_failing, "no comparison with the paper noticed the halved mesh stiffness"
     # and the comparisons really moved: the transmission error's STD grows as the mesh softens
     for m in ("I", "II"):
-        q = f"Table 2 STD, transmission error, model {m}"
+        q = f"Table 2 STD, transmission error, model {m} [rad]"  # with its unit
         assert half[q]["geardyn"] > 1.3 * nominal[q]["geardyn"]
 
 

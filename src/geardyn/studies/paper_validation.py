@@ -188,6 +188,11 @@ def consistency_checks(s: dict, *, paper_case: bool) -> list[dict]:
     return rows
 
 
+#: Units of the signals of Tables 2 and 3 (their STD and mean have them).
+_SIGNAL_UNITS = {"gear_vertical_velocity": "m/s", "pinion_angular_velocity": "rad/s",
+                 "transmission_error": "rad"}
+
+
 def paper_comparisons(table2: dict, table3: dict) -> list[dict]:
     """Comparisons of geardyn's Tables 2 and 3 (cracked pair) with the paper's.
 
@@ -215,8 +220,14 @@ def paper_comparisons(table2: dict, table3: dict) -> list[dict]:
                 why = ("damping values are not in the paper; STD scales with the response "
                        "amplitude" if stat == "std" else "a shape statistic: independent of the "
                        "amplitude")
-                row = factor_row(f"{table} {label}, {sig.replace('_', ' ')}, model {m}", paper,
-                                 ours, factor, source=f"paper, {table}", note=why)
+                # an STD or a mean has the signal's unit; a shape statistic has none (the rows
+                # read "Table 2 STD, ... | 0.01 | 0.00667" without one: a user audit)
+                unit = _SIGNAL_UNITS.get(sig, "") if stat in ("std", "mean") else ""
+                row = factor_row(f"{table} {label}, {sig.replace('_', ' ')}, model {m}"
+                                 + (f" [{unit}]" if unit else ""), paper, ours, factor,
+                                 source=f"paper, {table}", note=why)
+                if unit:
+                    row["unit"] = unit
                 row.update({"paper": paper, "table": table, "signal": sig, "model": m,
                             "statistic": stat})
                 rows.append(row)
