@@ -172,7 +172,8 @@ def crack_growth(
     force: ForceOption = False,
 ) -> None:
     """Grow the case's root crack (its crack section or a faults root_crack entry) under the
-    mesh force of motor.torque at the highest point of single tooth contact, then simulate a few
+    mesh force of motor.torque at the highest point of single tooth contact (at the design
+    centre distance; the operating one, opened by the bearings, puts it higher), then simulate a few
     crack lengths (PEM map of the equivalent straight crack, or with --stiffness fe the FE map
     of the grown path): the path, K_I, K_II, Paris cycles,
     the FE compliance and the indicators against cycles go to OUT as crack_growth.nc,

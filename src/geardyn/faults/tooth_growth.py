@@ -629,7 +629,9 @@ def growth_dataset(path: ToothCrackPath, outline: np.ndarray, *, case=None,
         "poisson_ratio": float(a["poisson_ratio"]),
         "model": "plane LEFM, quasi-static: a sector of the cracked gear clamped at the bore "
                  "and the radial cuts, the tooth load along the line of action at the highest "
-                 "point of single tooth contact; K by the interaction integral, direction by "
+                 "point of single tooth contact at the design centre distance (the static "
+                 "operating centre distance moves it up the flank: not modelled); K by the "
+                 "interaction integral, direction by "
                  "the maximum tangential stress criterion, remeshed each step "
                  "(geardyn.faults.tooth_growth)",
     }
