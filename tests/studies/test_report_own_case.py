@@ -40,6 +40,17 @@ def test_shipped_notes_are_marked_where_the_case_changed_what_they_describe():
     assert rows["pinion.teeth"][0] == "25"
 
 
+def test_notes_quoting_the_papers_operating_point_are_marked_for_another_load():
+    """"0.012 N m s/rad reproduces the paper's 1.07 mm" stood unmarked in the report of a case
+    whose torque and bearings give 0.35 mm (a user audit, 2026-11-27)."""
+    case = geardyn.paper_case({"motor.torque": "60 N m"})
+    rows = _rows(case, ["motor.torque"])
+    for key in ("pinion.torsional_damping", "stiffness.centre_distance_min"):
+        assert "1.07 mm" in rows[key][1]
+        assert rows[key][1].endswith("[note of the shipped case, for its motor.torque = 100.0: "
+                                     "not about this case]"), rows[key][1]
+
+
 def test_a_switched_off_section_is_shown_as_not_used():
     case = load_case(SPALL)
     assert case.crack.enabled is False

@@ -657,7 +657,7 @@ def report_stage(case: Case, out: Path, result: StudyResult) -> None:
     else:
         rep.table(["signal", "statistic", *_model_headers(False)], rows2, left_columns=2,
                   caption=cap2.replace("Table 2", "Statistics as the paper's Table 2")
-                  + I_STATIC_COLUMN_NOTE)
+                  + I_STATIC_NOTE_OWN_CASE)
     fig("fig12_spectra", "Fig. 12 analogue: RMS order spectra of the TSAs in dB re 1 unit, "
                          "mean removed (no DC bin); dotted lines mark the mesh harmonics.")
     fig("fig13_residuals", "Fig. 13 analogue: residual signals (all mesh harmonics removed).")
@@ -693,7 +693,7 @@ def report_stage(case: Case, out: Path, result: StudyResult) -> None:
     else:
         rep.table(["signal", "quantity", *_model_headers(False)], rows3, left_columns=2,
                   caption=cap3.replace("Table 3", "As the paper's Table 3")
-                  + I_STATIC_COLUMN_NOTE)
+                  + I_STATIC_NOTE_OWN_CASE)
 
     cm = s.get("condition_metrics", {})
     if cm:
@@ -1007,6 +1007,9 @@ def _measurement_section(rep: Report, m: dict, result: StudyResult, fig, case: C
 #: Appended to the captions of Tables 2 and 3.
 I_STATIC_COLUMN_NOTE = (". Model I-static (K(theta) at the static operating centre distance, "
                         "held fixed) is geardyn's addition: the paper has no such model ('-')")
+#: The same for a case that is not the paper's: no paper columns, so no '-' (a user audit).
+I_STATIC_NOTE_OWN_CASE = (". Model I-static (K(theta) at the static operating centre distance, "
+                          "held fixed) is geardyn's addition, not in the paper")
 
 
 def _model_headers(paper: bool) -> list[str]:

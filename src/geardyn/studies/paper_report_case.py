@@ -149,6 +149,12 @@ SHIPPED_NOTE_INPUTS = {
     "simulation.record_time": ("load.speed", "simulation.record_time"),
     "measurement.fs": ("pinion.teeth", "load.speed", "simulation.dt", "measurement.fs"),
     "measurement.tach_jitter": ("load.speed",),
+    # notes that quote the paper's 1.07 mm operating point, which the load, the bearings and
+    # the geometry set (unflagged in another case's report: a user audit, 2026-11-27)
+    "pinion.torsional_damping": (*_GEOMETRY_KEYS, "motor.torque", "pinion.bearing_stiffness",
+                                 "gear.bearing_stiffness"),
+    "stiffness.centre_distance_min": (*_GEOMETRY_KEYS, "motor.torque",
+                                      "pinion.bearing_stiffness", "gear.bearing_stiffness"),
 }
 
 
