@@ -184,9 +184,10 @@ def static_transmission_error(stiffness_map, torque: float, *,
 
 def static_te_of_case(case, torque: float | None = None, *, cracked: bool = False,
                       errors: bool = True, stiffness_map=None, **kw):
-    """:func:`static_transmission_error` of a case: its map (healthy by default), its
-    ``[modifications]`` (``errors=False``: perfect involutes) and ``torque`` (default: the
-    motor torque) [N m].
+    """:func:`static_transmission_error` of a case: its map (healthy by default, unlike
+    :func:`geardyn.stiffness.build_map` and :func:`geardyn.simulate`, whose ``cracked``
+    defaults to True), its ``[modifications]`` (``errors=False``: perfect involutes) and
+    ``torque`` (default: the motor torque) [N m]. ``cracked`` and ``errors`` are booleans.
 
     ``torque`` (and ``centre_distance_change`` among ``kw``) may be a number in SI units or a
     string with a unit as in a case file (``"100 N m"``, ``"0.5 mm"``), like the case's own

@@ -744,6 +744,22 @@ def load_case(path: str | Path | None = None, overrides: Iterable[str] | Mapping
 def paper_case(overrides: Iterable[str] | Mapping[str, Any] = ()) -> Case:
     """The paper's case (Xue & Howard 2018, Table 1 plus documented defaults).
 
-    ``overrides`` as in :func:`load_case`: ``"key=value"`` strings, one such string, or a mapping.
+    Parameters
+    ----------
+    overrides : iterable of str, str or mapping, optional
+        As in :func:`load_case`: ``"key=value"`` strings (``"motor.torque=80 N m"``), one such
+        string, or a mapping of dotted keys to values (numbers in SI units, or strings with a
+        unit, ``{"pinion.bearing_stiffness": "2e6 N/m"}``).
+
+    Returns
+    -------
+    Case
+        Validated; every value in SI units, with its source in ``provenance``. With overrides
+        the case is renamed ``"xue_howard (modified)"`` and its description names the keys.
+
+    Raises
+    ------
+    InputError
+        A bad key or value (the message names the dotted key, the value and what is allowed).
     """
     return load_case(None, overrides)
