@@ -157,7 +157,7 @@ def test_dataset_layout_of_every_variable(rich):
     assert ds["custom"].dims == dims2 + ("custom_dim2", "custom_dim3")
     assert ds["custom"].attrs == {"units": "", "long_name": "custom"}
     assert ds["slot_tooth"].dims == ("cycle", "slot")
-    assert ds["slot_tooth"].attrs == {"long_name": "pinion tooth of each load-share slot"}
+    assert ds["slot_tooth"].attrs == {"units": "1", "long_name": "pinion tooth of each load-share slot"}
     np.testing.assert_array_equal(ds["slot_tooth"].values, rich.slot_tooth)
     for name, v in rich.extra.items():
         np.testing.assert_array_equal(ds[name].values, v)
@@ -170,7 +170,7 @@ def test_dataset_layout_of_every_variable(rich):
     assert ds["node"].dims == ("node",)
     assert set(ds.indexes) == {"centre_distance_change", "node"}
     assert float(ds["phase_a"].sel(centre_distance_change=1e-4)) == rich.phase_a[1]
-    assert ds["node"].attrs == {"long_name": "boundary-fitted node index"}
+    assert ds["node"].attrs == {"units": "1", "long_name": "boundary-fitted node index"}
     np.testing.assert_array_equal(ds["theta"].values, rich.node_theta())
     np.testing.assert_array_equal(ds["torsional_stiffness"].values, rich.k_mb * RB ** 2)
     # attributes: containers, booleans and None as JSON text, numbers and strings as they are
