@@ -377,3 +377,16 @@ def test_every_variable_of_a_map_dataset_has_a_unit(kmap):
     ds = kmap.to_dataset()
     missing = [n for n, v in {**ds.data_vars, **ds.coords}.items() if "units" not in v.attrs]
     assert missing == []
+
+
+def test_a_ripple_with_a_speed_profile_is_refused():
+    """The ripple is a fixed-frequency torque (ripple_order x load.speed): in a run-up to
+    145 rad/s it sat at order 4.8 instead of 6 (a user audit, 2026-11-27). Either alone is
+    accepted."""
+    import geardyn
+
+    profile = {"motor.profile_times": [0.5, 1.0], "motor.profile_speeds": [114.14, 150.0]}
+    err = _refused(lambda: geardyn.paper_case({**profile, "motor.ripple": 0.02}), "motor.ripple")
+    assert "would not follow the run-up" in err.allowed
+    geardyn.paper_case(profile)
+    geardyn.paper_case({"motor.ripple": 0.02, "motor.ripple_order": 6})
