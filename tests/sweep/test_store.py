@@ -199,6 +199,34 @@ def test_another_sweep_in_the_store_is_refused_unless_force(tmp_path, client):
     assert (plain / "notes.txt").read_text() == "mine"
 
 
+def test_force_keeps_the_old_store_until_the_new_one_exists(tmp_path, client, monkeypatch):
+    """A --force sweep interrupted before its store was created had already deleted the old one
+    (a user audit, 2026-11-27): the old store is set aside and put back."""
+    import geardyn.studies.sweep.execute as execute
+
+    out = tmp_path / "s.zarr"
+    ev = OscillatorEvaluator(torque_limit=LIMIT)
+    run_sweep(osc_sweep(), out, client=client, evaluate=ev)
+    before = result_values(open_sweep(out).load())
+    other = osc_sweep(OSC_SWEEP.replace("seed = 11", "seed = 12"))
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(execute, "_create_store", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        run_sweep(other, out, client=client, evaluate=ev, force=True)
+    ds = open_sweep(out).load()
+    assert ds.attrs["seed"] == 11
+    for k, v in result_values(ds).items():
+        np.testing.assert_array_equal(v, before[k])
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.zarr"]  # nothing set aside left
+    monkeypatch.undo()
+    res = run_sweep(other, out, client=client, evaluate=ev, force=True)
+    assert res.computed == 12 and open_sweep(out).attrs["seed"] == 12
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.zarr"]
+
+
 def test_auto_batch_size_and_unstack(tmp_path, client):
     assert _auto_batch(0.3, 1.0, 1000, 2) == 4  # ceil(1 / 0.3) runs make a task of >= 1 s
     assert _auto_batch(0.01, 1.0, 1000, 2) == 100

@@ -42,6 +42,7 @@ from .store import (
     _remove_partials,
     _template,
     _write_batch,
+    restore_set_aside,
     store_status,
 )
 
@@ -426,10 +427,15 @@ def run_sweep(
     result.batch_size = batch
     if progress:
         progress(result.skipped, plan.n_runs)
-    if todo.size:
-        with _dask_client(scheduler, workers, client) as cl:
-            _execute(cl, sweep, plan, evaluator, out, digest, resumed, todo, batch, outputs,
-                     result, progress)
+    try:
+        if todo.size:
+            with _dask_client(scheduler, workers, client) as cl:
+                _execute(cl, sweep, plan, evaluator, out, digest, resumed, todo, batch,
+                         outputs, result, progress)
+    except BaseException:
+        restore_set_aside(out)  # --force over a store, stopped before the new one existed
+        raise
+    restore_set_aside(out)
     final = store_status(out)
     result.ok = int((final == STATUS_OK).sum())
     result.failed = int((final == STATUS_FAILED).sum())

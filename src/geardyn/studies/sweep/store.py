@@ -191,6 +191,9 @@ def _create_store(out: Path, ds, batch: int) -> None:
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
         raise
+    backup = _SET_ASIDE.pop(out, None)  # the store --force replaces: now it may go
+    if backup is not None:
+        shutil.rmtree(backup, ignore_errors=True)
 
 
 def _remove_partials(out: Path) -> int:
@@ -409,6 +412,23 @@ def _check_values_shapes(values: Mapping[str, Any], outputs: Sequence[Output]) -
 
 
 
+#: Stores that ``--force`` set aside until their replacement exists: new path -> old store.
+_SET_ASIDE: dict[Path, Path] = {}
+
+
+def restore_set_aside(out: Path) -> bool:
+    """Put back the store that ``--force`` set aside for ``out`` when no new store was created
+    (an error or an interrupt before it); True if it was put back."""
+    backup = _SET_ASIDE.pop(out, None)
+    if backup is None or not backup.exists():
+        return False
+    if out.exists():  # a new store exists after all: the old one goes
+        shutil.rmtree(backup, ignore_errors=True)
+        return False
+    os.rename(backup, out)
+    return True
+
+
 def _check_out(out: Path, digest: str, force: bool) -> bool:
     """True if ``out`` holds this sweep (resume); False if it must be created."""
     if not out.exists() or (out.is_dir() and not any(out.iterdir())):
@@ -423,7 +443,13 @@ def _check_out(out: Path, digest: str, force: bool) -> bool:
     if attrs.get("sweep_hash") == digest:
         return True
     if force:
-        shutil.rmtree(out)
+        # set aside, not deleted: the old store goes only once the new one exists (an
+        # interrupted --force deleted it with nothing in its place: a user audit, 2026-11-27)
+        backup = out.with_name(f"{out.name}.replaced-by-pid{os.getpid()}")
+        if backup.exists():
+            shutil.rmtree(backup)
+        os.rename(out, backup)
+        _SET_ASIDE[out] = backup
         return False
     raise InputError("--out", str(out), f"a new store, or the store of this same sweep: it "
                                         f"holds a different sweep ('{attrs.get('sweep_name')}', "
