@@ -49,9 +49,14 @@ def parse_age(text: str, field_name: str = "--older-than") -> float:
 
 
 def _is_entry(path: Path) -> bool:
+    """A geardyn entry: a file with the ``.sha256`` sidecar :meth:`Cache.store` writes beside
+    it. Any other file under the cache folder is not geardyn's to count or remove (``cache
+    clear`` removed a user's CSV files under a folder the cache variable pointed at: a user
+    audit, 2026-11-27)."""
     name = path.name
     return (path.is_file() and not name.endswith(_SIDE_SUFFIXES) and ".tmp" not in name
-            and not name.startswith("."))
+            and not name.startswith(".")
+            and path.with_name(name + ".sha256").is_file())
 
 
 @dataclass(frozen=True)

@@ -161,3 +161,22 @@ def test_a_kind_with_a_space_may_be_typed_with_an_underscore_or_a_hyphen(tmp_pat
         assert dry.removed["map values"][0] == 2, spelling
     with pytest.raises(InputError, match="--kind"):
         prune(cache, kinds=("map__values",))
+
+
+def test_files_geardyn_did_not_write_are_neither_counted_nor_removed(tmp_path):
+    """``cache clear --kind measurements --yes`` removed a user's CSV files under a folder the
+    cache variable pointed at (a user audit, 2026-11-27): an entry is a file with geardyn's
+    ``.sha256`` sidecar."""
+    cache = _fill(tmp_path / "c", time.time())
+    mine = tmp_path / "c" / "measurements"
+    mine.mkdir()
+    for k in range(3):
+        (mine / f"run{k}.csv").write_text("1\n")
+    (tmp_path / "c" / "maps" / "notes.txt").write_text("mine")
+    kinds = {u.kind: u.entries for u in cache_usage(cache)}
+    assert kinds.get("measurements", 0) == 0
+    r = _cli("clear", "--yes", cache=tmp_path / "c")
+    assert r.exit_code == 0, r.output
+    assert sorted(p.name for p in mine.iterdir()) == ["run0.csv", "run1.csv", "run2.csv"]
+    assert (tmp_path / "c" / "maps" / "notes.txt").read_text() == "mine"
+    assert sum(u.entries for u in cache_usage(cache)) == 0  # geardyn's own are gone
