@@ -175,8 +175,8 @@ def test_files_geardyn_did_not_write_are_neither_counted_nor_removed(tmp_path):
     (tmp_path / "c" / "maps" / "notes.txt").write_text("mine")
     kinds = {u.kind: u.entries for u in cache_usage(cache)}
     assert kinds.get("measurements", 0) == 0
-    r = _cli("clear", "--yes", cache=tmp_path / "c")
-    assert r.exit_code == 0, r.output
+    r = _cli("cache", "clear", "--yes", cache=tmp_path / "c")
+    assert r.returncode == 0, r.stderr
     assert sorted(p.name for p in mine.iterdir()) == ["run0.csv", "run1.csv", "run2.csv"]
     assert (tmp_path / "c" / "maps" / "notes.txt").read_text() == "mine"
     assert sum(u.entries for u in cache_usage(cache)) == 0  # geardyn's own are gone
