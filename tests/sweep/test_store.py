@@ -157,6 +157,64 @@ def test_torn_status_chunk_counts_as_pending(tmp_path, client):
         np.testing.assert_array_equal(ds[k].values, v, err_msg=k)
 
 
+def test_verify_names_torn_and_lost_status_chunks_and_a_damaged_plan(tmp_path, client):
+    """A user audit (2026-11-27): a truncated or deleted status chunk and a truncated or edited
+    swept-value column all passed --verify as "ok"; the column then read back as garbage."""
+    import shutil
+
+    from geardyn.studies.sweep import verify_store
+
+    sw = osc_sweep()
+    ref = tmp_path / "ref.zarr"
+    ev = OscillatorEvaluator(torque_limit=LIMIT)
+    run_sweep(sw, ref, client=client, evaluate=ev)
+    assert verify_store(ref).ok and verify_store(ref).plan == "ok"
+
+    torn = tmp_path / "torn.zarr"
+    shutil.copytree(ref, torn)
+    (torn / "status" / "1").write_bytes(b"\x28\xb5\x2f")
+    check = verify_store(torn)
+    assert not check.ok and [(d.start, d.stop) for d in check.damaged] == [(5, 10)]
+    assert "the status chunk cannot be read" in check.summary()
+
+    lost = tmp_path / "lost.zarr"
+    shutil.copytree(ref, lost)
+    (lost / "status" / "0").unlink()
+    check = verify_store(lost)
+    assert not check.ok and "the status chunk was lost" in check.summary()
+
+    for name, damage in (("motor.torque", "truncate"), ("seed", "edit")):
+        bad = tmp_path / f"{name}.zarr"
+        shutil.copytree(ref, bad)
+        if damage == "truncate":
+            (bad / name / "0").write_bytes((bad / name / "0").read_bytes()[:10])
+        else:
+            import zarr
+
+            zarr.open_group(str(bad), mode="r+")[name][0] = 999
+        check = verify_store(bad)
+        assert not check.ok and check.plan != "ok", name
+        assert "the plan is damaged" in check.summary()
+        with pytest.raises(DataFileError, match="damaged plan"):
+            run_sweep(sw, bad, client=client, evaluate=ev)
+        with pytest.raises(DataFileError, match="the plan is damaged"):
+            open_sweep(bad)
+
+
+def test_verify_counts_the_pending_runs(tmp_path, client):
+    import zarr
+
+    from geardyn.studies.sweep import verify_store
+
+    out = tmp_path / "s.zarr"
+    run_sweep(osc_sweep(), out, client=client, evaluate=OscillatorEvaluator(torque_limit=LIMIT))
+    g = zarr.open_group(str(out), mode="r+")
+    g["status"][10:] = 0
+    g["batch_checksum"][2] = ""  # as before the batch was written
+    check = verify_store(out)
+    assert check.ok and check.pending == 2 and check.summary().endswith("2 run(s) pending")
+
+
 def test_failed_runs_stay_recorded_unless_retry_failed(tmp_path, client):
     marker = tmp_path / "flaky"
     marker.write_text("")

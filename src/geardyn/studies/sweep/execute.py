@@ -416,6 +416,8 @@ def run_sweep(
     if resumed:
         _remove_partials(out)
         check = verify_store(out, repair=True)  # damaged batches go back to pending
+        if check.plan not in ("ok", "unchecked"):  # the inputs of the runs: nothing to redo
+            raise DataFileError(out, f"holds a damaged plan: {check.plan}")
         result.damaged = [str(d) for d in check.damaged]
         result.metadata_rebuilt = check.metadata == "rebuilt"
         status = store_status(out, repair=True)

@@ -58,6 +58,15 @@ def _start(start: int, stop: int):
     return hashlib.sha256(f"geardyn-batch:{start}:{stop}".encode())
 
 
+def plan_digest(columns: Mapping[str, np.ndarray]) -> str:
+    """The checksum of a store's plan: the swept values and seeds of every run (name ->
+    values), which the store writes once, when it is created."""
+    h = hashlib.sha256(b"geardyn-plan")
+    for name in sorted(columns):
+        _update(h, name, np.asarray(columns[name]))
+    return h.hexdigest()
+
+
 def batch_digest(start: int, stop: int, columns: Mapping[str, np.ndarray]) -> str:
     """The checksum of batch ``[start, stop)`` holding ``columns`` (name -> values of its runs)."""
     h = _start(start, stop)
@@ -119,11 +128,13 @@ class StoreCheck:
     damaged: tuple[DamagedBatch, ...]
     metadata: str = "ok"
     repaired: bool = False
+    pending: int = 0
+    plan: str = "ok"
 
     @property
     def ok(self) -> bool:
-        """True if no batch is damaged."""
-        return not self.damaged
+        """True if no batch is damaged and the plan (swept values, seeds) is intact."""
+        return not self.damaged and self.plan == "ok"
 
     @property
     def damaged_runs(self) -> np.ndarray:
@@ -134,12 +145,15 @@ class StoreCheck:
 
     def summary(self, limit: int = 5) -> str:
         """One line: the damaged batches (at most ``limit`` named) or that all is well."""
+        plan = "" if self.plan in ("ok", "unchecked") else f"the plan is damaged: {self.plan}; "
+        left = f"; {self.pending} run(s) pending" if self.pending else ""
         if not self.damaged:
-            return (f"{self.checked} of {self.batches} batch(es) checked, all match their "
-                    "checksums")
+            return (f"{plan}{self.checked} of {self.batches} batch(es) checked, all match their "
+                    f"checksums{left}")
         named = "; ".join(str(d) for d in self.damaged[:limit])
         more = f"; and {len(self.damaged) - limit} more" if len(self.damaged) > limit else ""
-        return (f"{len(self.damaged)} of {self.checked} checked batch(es) damaged: {named}{more}")
+        return (f"{plan}{len(self.damaged)} of {self.checked} checked batch(es) damaged: "
+                f"{named}{more}{left}")
 
 
 # --------------------------------------------------------------------------------------------
@@ -266,6 +280,13 @@ def verify_store(path: str | os.PathLike, *, repair: bool = False) -> StoreCheck
     bounds = [(i, i * b, min(n, (i + 1) * b)) for i in range(n_batches)]
     check = [i for i, a, z in bounds if i not in bad_status and (status[a:z] != 0).any()]
     damaged: dict[int, str] = {i: "the checksum cannot be read" for i in check if i in bad_sums}
+    # a status chunk unreadable, or lost (read back as pending) while its batch's checksum is
+    # stored: both passed as "ok" (a user audit, 2026-11-27)
+    lost: dict[int, str] = {i: "the status chunk cannot be read" for i in sorted(bad_status)}
+    lost.update({i: "its status reads pending but its checksum is stored (the status chunk "
+                    "was lost)" for i, a, z in bounds
+                 if i not in bad_status and i not in bad_sums and str(sums[i])
+                 and not (status[a:z] != 0).any()})
     hashers = {i: _start(bounds[i][1], bounds[i][2]) for i in check if i not in damaged}
     for name in sorted(names):
         live = [i for i in check if i not in damaged]
@@ -301,9 +322,39 @@ def verify_store(path: str | os.PathLike, *, repair: bool = False) -> StoreCheck
         if i not in damaged and hashers[i].hexdigest() != str(sums[i]):
             damaged[i] = ("no checksum stored" if not str(sums[i])
                           else "the stored values differ from their checksum")
+    damaged.update(lost)
     found = tuple(DamagedBatch(i, bounds[i][1], bounds[i][2], damaged[i]) for i in sorted(damaged))
     if repair:
         for i in sorted(bad_status | set(damaged)):
             a, z = bounds[i][1], bounds[i][2]
             g["status"][a:z] = np.zeros(z - a, dtype=np.int8)
-    return StoreCheck(p, n, n_batches, len(check), found, metadata, repair)
+    pending = int(sum(int((status[a:z] == 0).sum()) for i, a, z in bounds
+                      if i not in damaged))
+    return StoreCheck(p, n, n_batches, len(check), found, metadata, repair,
+                      pending=pending, plan=_check_plan(g, attrs, n))
+
+
+def _check_plan(g, attrs: dict, n: int) -> str:
+    """"ok" if the swept values and seeds match the plan checksum written at creation,
+    "unchecked" for a store without one (an older geardyn), else what is wrong: they were
+    covered by no checksum, and a truncated or edited parameter column read back as garbage
+    while the store verified "ok" (a user audit, 2026-11-27)."""
+    names = attrs.get("plan_variables")
+    want = attrs.get("plan_checksum")
+    if not isinstance(names, list) or not want:
+        return "unchecked"
+    cols = {}
+    for name in names:
+        if name not in g:
+            return f"the variable {name} is missing"
+        try:
+            cols[name] = np.asarray(g[name][:])
+        except Exception as exc:  # an undecodable chunk
+            return f"{name} cannot be read ({type(exc).__name__})"
+        if cols[name].shape[0] != n:
+            return f"{name} holds {cols[name].shape[0]} values, not {n}"
+    if plan_digest(cols) != want:
+        return ("the swept values or seeds differ from their checksum (" + ", ".join(names)
+                + "); the runs cannot be recomputed from them: run the sweep again with "
+                "--force")
+    return "ok"

@@ -49,6 +49,7 @@ from .integrity import (
     batch_digest,
     check_metadata,
     open_store_group,
+    plan_digest,
     verify_store,
 )
 from .spec import STORE_FORMAT, Sweep, SweepPlan
@@ -141,6 +142,10 @@ def _template(sweep: Sweep, plan: SweepPlan, digest: str, evaluator: Evaluator, 
         "created": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
         "status_codes": "0 pending, 1 ok, 2 failed",
         "checksum_variables": sorted([*_CORE_VARS, *(o.name for o in outputs)]),
+        # the swept values and seeds, written once: their own checksum (verify_store)
+        "plan_variables": sorted([*(p.key for p in plan.parameters), "seed"]),
+        "plan_checksum": plan_digest({**{p.key: plan.values[p.key] for p in plan.parameters},
+                                      "seed": plan.seeds}),
     }
     return ds
 
