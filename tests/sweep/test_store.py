@@ -246,6 +246,8 @@ def test_another_sweep_in_the_store_is_refused_unless_force(tmp_path, client):
     with pytest.raises(InputError) as info:
         run_sweep(other, out, client=client, evaluate=ev)
     assert info.value.field == "--out" and "--force" in str(info.value)
+    # what changed is named (it said only "another definition or geardyn version")
+    assert "changed: seed: 11 -> 12" in info.value.allowed, info.value.allowed
     res = run_sweep(other, out, client=client, evaluate=ev, force=True)
     assert res.computed == 12 and not res.resumed
     assert open_sweep(out).attrs["seed"] == 12

@@ -408,7 +408,7 @@ def run_sweep(
     plan = sweep.plan()
     out = Path(out).absolute()
     digest = sweep_digest(sweep, evaluator)
-    resumed = _check_out(out, digest, force)
+    resumed = _check_out(out, digest, force, sweep.definition())
     result = SweepResult(out=out, n_runs=plan.n_runs, resumed=resumed)
 
     status = np.zeros(plan.n_runs, dtype=np.int8)

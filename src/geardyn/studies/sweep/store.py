@@ -434,7 +434,41 @@ def restore_set_aside(out: Path) -> bool:
     return True
 
 
-def _check_out(out: Path, digest: str, force: bool) -> bool:
+def _definition_changes(stored: str | None, new: dict | None, limit: int = 2) -> str:
+    """What differs between a store's ``sweep_definition`` (JSON) and ``new``: "axes.x: [..] ->
+    [..]; ..." (at most ``limit`` keys), or "" when either is unknown."""
+    if not stored or new is None:
+        return ""
+    try:
+        old = json.loads(stored)
+        new = json.loads(json.dumps(new, default=float))
+    except (TypeError, ValueError):
+        return ""
+
+    def flat(node, prefix=""):
+        if (isinstance(node, list) and node and all(
+                isinstance(e, list) and len(e) == 2 and isinstance(e[0], str) for e in node)):
+            node = dict(node)  # the axes: [[key, values], ...], in order
+        if isinstance(node, dict):
+            out = {}
+            for k, v in node.items():
+                out.update(flat(v, f"{prefix}.{k}" if prefix else str(k)))
+            return out
+        return {prefix: node}
+
+    a, b = flat(old), flat(new)
+    keys = [k for k in sorted(set(a) | set(b)) if a.get(k) != b.get(k)]
+
+    def short(v) -> str:
+        text = json.dumps(v)
+        return text if len(text) <= 30 else text[:27] + "..."
+
+    parts = [f"{k}: {short(a.get(k))} -> {short(b.get(k))}" for k in keys[:limit]]
+    more = f"; and {len(keys) - limit} more" if len(keys) > limit else ""
+    return "; ".join(parts) + more
+
+
+def _check_out(out: Path, digest: str, force: bool, definition: dict | None = None) -> bool:
     """True if ``out`` holds this sweep (resume); False if it must be created."""
     if not out.exists() or (out.is_dir() and not any(out.iterdir())):
         return False  # new (an empty folder is replaced by the store)
@@ -456,10 +490,17 @@ def _check_out(out: Path, digest: str, force: bool) -> bool:
         os.rename(out, backup)
         _SET_ASIDE[out] = backup
         return False
+    from ..._version import __version__
+
+    what = _definition_changes(attrs.get("sweep_definition"), definition)
+    if not what and attrs.get("geardyn_version") != __version__:
+        what = f"geardyn {attrs.get('geardyn_version')} -> {__version__}"
     raise InputError("--out", str(out), f"a new store, or the store of this same sweep: it "
-                                        f"holds a different sweep ('{attrs.get('sweep_name')}', "
-                                        "another definition or geardyn version); pass --force "
-                                        "to overwrite it")
+                                        f"holds a different sweep ('{attrs.get('sweep_name')}'"
+                                        + (f"; changed: {what}" if what else ", another "
+                                           "definition or geardyn version")
+                                        + "); pass --force to replace it (its finished runs are "
+                                        "lost), or choose another --out")
 
 
 def _outputs_from_store(out: Path) -> tuple[Output, ...]:
