@@ -197,7 +197,12 @@ class Cache:
                 else:
                     self.discard(path)
             obj = build()
-            self.store(obj, path, key, save)
+            try:
+                self.store(obj, path, key, save)
+            except Exception as exc:  # a full disk: the cache is an optimisation, the result
+                if not _disk_full(path, exc):  # stands without it
+                    raise
+                _say_full(path, exc)
         _note_lookup(kind, key, False)
         return obj, False
 
@@ -247,7 +252,16 @@ class Cache:
                 else:
                     _touch(path)
             if not hit:
-                self.store(None, path, key, lambda _obj, tmp: write(tmp))
+                try:
+                    self.store(None, path, key, lambda _obj, tmp: write(tmp))
+                except Exception as exc:
+                    if not _disk_full(path, exc):
+                        raise
+                    _say_full(path, exc)  # written straight to the target instead
+                    with atomic_path(target, suffix=target.suffix) as tmp:
+                        write(tmp)
+                    _note_lookup(kind, key, False)
+                    return False
             with atomic_path(target, suffix=target.suffix) as tmp:
                 shutil.copyfile(path, tmp)
         _note_lookup(kind, key, hit, path)
@@ -273,6 +287,47 @@ class Cache:
 
 #: Active lookup recorders (see :func:`record_lookups`); each is a list of dicts.
 _RECORDERS: list[tuple[list[dict], float]] = []  # (lookups, wall time the block began)
+
+
+#: Free bytes below which a failed cache write is taken for a full disk.
+_FULL_BELOW = 8 << 20
+
+
+def _disk_full(path: Path, exc: BaseException) -> bool:
+    """Whether writing the cache entry ``path`` failed because its disk is full: ENOSPC or
+    EDQUOT, or (netCDF-C and HDF5 report a full disk as "Permission denied" or "HDF error")
+    any error while the disk holds less than :data:`_FULL_BELOW` free bytes."""
+    import errno
+    import shutil
+
+    if isinstance(exc, OSError) and exc.errno in (errno.ENOSPC, errno.EDQUOT):
+        return True
+    try:
+        return shutil.disk_usage(path.parent if path.parent.exists() else cache_dir()).free \
+            < _FULL_BELOW
+    except OSError:
+        return False
+
+
+_SAID_FULL: set[str] = set()
+
+
+def _say_full(path: Path, exc: BaseException) -> None:
+    """Warn once per cache folder that it is full and results go uncached (a sweep whose
+    cache filled its disk failed every run with "Permission denied": a user audit)."""
+    import warnings
+
+    folder = str(path.parent.parent)
+    if folder in _SAID_FULL:
+        return
+    _SAID_FULL.add(folder)
+    warnings.warn(f"the geardyn cache {folder} is on a full disk ({type(exc).__name__}: "
+                  f"{exc}); results are computed without being cached: free space or point "
+                  "GEARDYN_CACHE_DIR elsewhere", CacheFullWarning, stacklevel=3)
+
+
+class CacheFullWarning(UserWarning):
+    """The cache's disk is full: results are computed, not cached."""
 
 
 def _note_lookup(kind: str, key: str, hit: bool, path: Path | None = None) -> None:
