@@ -11,7 +11,7 @@ runs; batches whose stored values fail their checksums are computed again (and n
 from __future__ import annotations
 
 import importlib
-from collections import Counter
+import re
 from pathlib import Path
 from typing import Annotated
 
@@ -63,6 +63,10 @@ def with_base_case(sw, config: Path | None, overrides: list[str]):
                    + [f"--set {shlex.quote(o)}" for o in overrides])
     return dataclasses.replace(sw, base_case=base,
                                text=sw.text.rstrip("\n") + f"\n# geardyn sweep {cli}\n")
+
+
+#: A number in a failure message (replaced to group the failures by cause).
+_NUMBER = re.compile(r"[-+]?\d+(?:\.\d*)?(?:[eE][-+]?\d+)?")
 
 
 def verify(store: Path) -> None:
@@ -174,9 +178,20 @@ def sweep(
     if result.failed:
         ds = open_sweep(result.out, verify=False)  # verified by the resume; only read errors
         errors = ds["error"].values[ds["status"].values == 2]
-        for msg, n in Counter(str(e) for e in errors).most_common(3):
-            err_console.print(f"  [yellow]{n} failed[/yellow]: {msg}", highlight=False,
-                              soft_wrap=True)
+        # one cause, one line: the same failure differs from run to run only in its numbers
+        # (three lines of one cause took the summary's three places: a user audit)
+        causes: dict[str, tuple[int, str]] = {}
+        for e in (str(e) for e in errors):
+            shape = _NUMBER.sub("#", e)
+            n, first = causes.get(shape, (0, e))
+            causes[shape] = (n + 1, first)
+        for n, first in sorted(causes.values(), key=lambda c: -c[0])[:3]:
+            err_console.print(f"  [yellow]{n} failed[/yellow]"
+                              + (" (numbers of the first)" if n > 1 else "") + f": {first}",
+                              highlight=False, soft_wrap=True)
+        if len(causes) > 3:
+            err_console.print(f"  ... and {len(causes) - 3} other cause(s): see the store's "
+                              "'error' variable", highlight=False)
         if not retry_failed:
             err_console.print("  (failed runs stay recorded; --retry-failed computes them "
                               "again)")
