@@ -331,7 +331,11 @@ def _local_client(n: int, method: str) -> Iterator[Any]:
                 cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
                                        dashboard_address="127.0.0.1:0",
                                        scheduler_kwargs={"dashboard": False},
-                                       silence_logs=logging.ERROR)
+                                       # a failed task is reported by the sweep itself ("task
+                                       # lost: ..." with its error, the runs left pending):
+                                       # the workers' own tracebacks of it were noise (a full
+                                       # disk printed four, a user audit of 2026-11-27)
+                                       silence_logs=logging.CRITICAL)
                 cl = Client(cluster)
             yield cl
         finally:
