@@ -287,6 +287,24 @@ def test_force_keeps_the_old_store_until_the_new_one_exists(tmp_path, client, mo
     assert sorted(p.name for p in tmp_path.iterdir()) == ["s.zarr"]
 
 
+def test_a_store_another_sweep_is_writing_is_refused(tmp_path, client):
+    """Two commands on one store both computed every pending run (a user audit, 2026-11-27):
+    the second is refused while the first holds the store's lock, and runs once it is gone."""
+    from filelock import FileLock
+
+    out = tmp_path / "s.zarr"
+    ev = OscillatorEvaluator(torque_limit=LIMIT)
+    held = FileLock(str(tmp_path / ".s.zarr.lock"))
+    held.acquire()
+    try:
+        with pytest.raises(InputError, match="another sweep is writing this one now"):
+            run_sweep(osc_sweep(), out, client=client, evaluate=ev)
+    finally:
+        held.release()
+    assert not out.exists()
+    assert run_sweep(osc_sweep(), out, client=client, evaluate=ev).computed == 12
+
+
 def test_auto_batch_size_and_unstack(tmp_path, client):
     assert _auto_batch(0.3, 1.0, 1000, 2) == 4  # ceil(1 / 0.3) runs make a task of >= 1 s
     assert _auto_batch(0.01, 1.0, 1000, 2) == 100

@@ -412,6 +412,37 @@ def run_sweep(
     plan = sweep.plan()
     out = Path(out).absolute()
     digest = sweep_digest(sweep, evaluator)
+    with _store_lock(out):
+        return _run_locked(sweep, out, digest, evaluator, plan, force, retry_failed,
+                           scheduler, workers, client, progress, t_start)
+
+
+@contextlib.contextmanager
+def _store_lock(out: Path):
+    """One sweep at a time writes a store: a second command on the same store is refused
+    (two computed all 20 pending runs each, a user audit of 2026-11-27). The lock is the
+    hidden file ``.<store>.lock`` beside the store (``flock``)."""
+    from filelock import FileLock, Timeout
+
+    out.parent.mkdir(parents=True, exist_ok=True)
+    lock = FileLock(str(out.with_name(f".{out.name}.lock")))
+    try:
+        lock.acquire(timeout=0)
+    except Timeout:
+        raise InputError("--out", str(out), "a store no other geardyn sweep is writing: another "
+                                            "sweep is writing this one now (wait for it to "
+                                            "end; the same command then resumes it)") from None
+    try:
+        yield
+    finally:
+        lock.release()
+        with contextlib.suppress(OSError):  # nothing left beside the store
+            os.unlink(lock.lock_file)
+
+
+def _run_locked(sweep, out, digest, evaluator, plan, force, retry_failed, scheduler, workers,
+                client, progress, t_start) -> SweepResult:
+    """:func:`run_sweep` once the store's lock is held."""
     resumed = _check_out(out, digest, force, sweep.definition())
     result = SweepResult(out=out, n_runs=plan.n_runs, resumed=resumed)
 
