@@ -91,6 +91,9 @@ def runup_comparison(base=None, *, ratios: tuple[float, float] = (0.6, 1.5),
         "load.law": "constant", "load.speed": w0,
         "motor.profile_times": [settle, settle + ramp_time],
         "motor.profile_speeds": [w0, w1], "motor.drive_gain": drive_gain,
+        # no ripple: a fixed-frequency torque does not follow the run-up (refused with a
+        # profile); the comparison of II with I-static does not need one
+        "motor.ripple": 0.0,
         "simulation.settle_time": settle, "simulation.record_time": ramp_time,
         "simulation.stiffness_evaluation": "predictor"}, source="model-II run-up")
     runs = {}
