@@ -12,7 +12,6 @@ import numpy as np
 import pytest
 
 from geardyn.config import load_case
-from geardyn.dynamics.newmark import _widest_zero_window
 from geardyn.errors import NumericalError
 from geardyn.stiffness import build_map
 
@@ -39,12 +38,12 @@ def test_the_zero_window_of_a_broken_tooth(height, gap):
     case = load_case(BREAKAGE, [*PEM, f'faults.0.height="{height}"'])
     m = build_map(case, cracked=True)
     for dd in (0.0, m.dd[-1]):
-        w = _widest_zero_window(m, dd)
+        w = m.zero_window(dd)
         assert w == pytest.approx(_zero_width_fine(m, dd), abs=2 * m.period / 4096)
     # at the design centre distance: 4 mm leaves a pair in contact, 6 mm does not (both open a
     # window as the centre distance grows and the contact ratio falls)
-    assert (_widest_zero_window(m, 0.0) > 0) is gap
-    assert _widest_zero_window(m, m.dd[-1]) > _widest_zero_window(m, 0.0)
+    assert (m.zero_window(0.0) > 0) is gap
+    assert m.zero_window(m.dd[-1]) > m.zero_window(0.0)
 
 
 @pytest.mark.slow
@@ -59,4 +58,4 @@ def test_the_runaway_error_names_the_gap_not_the_time_step():
     assert "no tooth pair in contact" in text and "reduce simulation.dt" not in text
     deg = float(text.split("zero over ")[1].split(" deg")[0])
     dd = err.value.state["centre_distance_change"]
-    assert deg == pytest.approx(math.degrees(_widest_zero_window(m, dd)), rel=1e-2)
+    assert deg == pytest.approx(math.degrees(m.zero_window(dd)), rel=1e-2)

@@ -167,7 +167,6 @@ def stiffness(
         t.caption = "* between the map's centre distances: interpolated in the map"
     console.print(t)
     notes = sorted({w for m in maps.values() for w in _map_warnings(m)})
-    from ..dynamics.newmark import _widest_zero_window
     from ..errors import GeardynError
 
     try:  # where the run will be: the static operating centre distance
@@ -178,7 +177,7 @@ def stiffness(
     except GeardynError:
         d_op = 0.0
     for name, m in maps.items():  # a fault that leaves no pair in contact: said before a run
-        gap = _widest_zero_window(m, d_op)
+        gap = m.zero_window(d_op)
         if gap > 0:
             notes.append(f"the {name} map is zero over {np.degrees(gap):.3g} deg of pinion "
                          f"rotation at the static operating centre distance ({d_op * 1e3:+.3f} "

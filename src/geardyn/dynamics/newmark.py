@@ -743,25 +743,6 @@ def check_model_options(case) -> None:
                          "of action: set simulation.dynamics = 'transverse')")
 
 
-def _widest_zero_window(stiffness_map: StiffnessMap, dd: float, n: int = 4096) -> float:
-    """The widest range of pinion angle [rad] over which the map's mesh stiffness is zero at
-    the centre distance change ``dd`` [m] (clipped to the map's range): 0 where a pair is in
-    contact everywhere. The map is periodic, so a window may wrap around its end."""
-    d = float(np.clip(dd if math.isfinite(dd) else 0.0, stiffness_map.dd[0],
-                      stiffness_map.dd[-1]))
-    th = np.linspace(0.0, stiffness_map.period, n, endpoint=False)
-    zero = np.asarray(stiffness_map(th, d), float) <= 0.0
-    if not zero.any():
-        return 0.0
-    if zero.all():
-        return stiffness_map.period
-    # runs of zeros, the last joined to the first across the period's end
-    z = np.roll(zero, -int(np.argmin(zero)))  # start at a non-zero node
-    edges = np.flatnonzero(np.diff(np.r_[0, z.astype(np.int8), 0]))
-    longest = int(np.max(edges[1::2] - edges[::2]))
-    return longest * stiffness_map.period / n
-
-
 def _numerical_error(status: int, fail: np.ndarray, stiffness_map: StiffnessMap,
                      which: str) -> NumericalError:
     msg = f"model {which}: {K.STATUS_TEXT.get(status, f'status {status}')}"
@@ -772,7 +753,7 @@ def _numerical_error(status: int, fail: np.ndarray, stiffness_map: StiffnessMap,
     elif status == K.NOT_CONVERGED:
         msg += " (raise simulation.max_iterations or simulation.tolerance, or reduce dt)"
     else:
-        gap = _widest_zero_window(stiffness_map, float(fail[5]))
+        gap = stiffness_map.zero_window(float(fail[5]))
         if status == K.MESH_RUNAWAY and gap > 0:
             # a fault that leaves no pair in contact (a broken tooth taller than the contact
             # ratio allows): dt and the integrator do not help (a user audit, 2026-11-27)

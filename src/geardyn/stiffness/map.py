@@ -471,6 +471,22 @@ class StiffnessMap:
                 f"changes {dd[0]:+.4g}..{dd[-1]:+.4g} mm, {self.n_cycles} mesh cycles x "
                 f"{2 * self.n_seg} nodes, k_mb {k.min():.4g}..{k.max():.4g} N/m)")
 
+    def zero_window(self, dd: float, n: int = 4096) -> float:
+        """The widest range of pinion angle [rad] over which the mesh stiffness is zero (no
+        tooth pair in contact, as a broken tooth can leave) at the centre distance change
+        ``dd`` [m] (clipped to the map's range; ``n`` angles over the period): 0 where a pair
+        is in contact everywhere. The map is periodic, so a window may wrap around its end."""
+        d = float(np.clip(dd if np.isfinite(dd) else 0.0, self.dd[0], self.dd[-1]))
+        th = np.linspace(0.0, self.period, n, endpoint=False)
+        zero = np.asarray(self(th, d), float) <= 0.0
+        if not zero.any():
+            return 0.0
+        if zero.all():
+            return self.period
+        z = np.roll(zero, -int(np.argmin(zero)))  # start at a node in contact
+        edges = np.flatnonzero(np.diff(np.r_[0, z.astype(np.int8), 0]))
+        return int(np.max(edges[1::2] - edges[::2])) * self.period / n
+
     def covers(self, dd: float) -> bool:
         """Whether ``dd`` [m] lies inside the map's centre-distance range."""
         if self.dd.size == 1:
