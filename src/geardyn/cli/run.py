@@ -90,6 +90,10 @@ def run(
     from ..processes import fe_processes
 
     fe_processes()  # a bad GEARDYN_FE_PROCESSES refused before the output folder is claimed
+    if case.stiffness.method == "fe":  # and a bad GEARDYN_FE_SOLVER
+        from ..stiffness.fe.factor import default_solver
+
+        default_solver()
     state = claim_folder(target, ident, force=force, results=RESULTS + OTHER_RESULTS)
     say_state(state, target)
     with (input_errors_recorded(target, ident), progress_bar() as bar,

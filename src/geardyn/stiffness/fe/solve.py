@@ -6,8 +6,8 @@ Linear elasticity per unit face width on the body mesh of :mod:`.mesh`, quadrati
 (``ElementVector(ElementTriP2())``), the bore fixed (the hub is rigid; the pinion's hub rotation is
 added as a rigid-body term by :mod:`.contact`). Plane strain (default) uses the Lame constants
 ``lambda = E nu / ((1 + nu)(1 - 2 nu))``, ``mu = E / (2 (1 + nu))``; plane stress replaces lambda by
-``2 lambda mu / (lambda + 2 mu)``. The stiffness matrix is factorised once (SuperLU, ``splu``) and
-solved for many right-hand sides.
+``2 lambda mu / (lambda + 2 mu)``. The stiffness matrix is factorised once (CHOLMOD's Cholesky
+where installed, SuperLU otherwise: :mod:`.factor`) and solved for many right-hand sides.
 
 Loads: a Hertzian pressure patch
 --------------------------------
@@ -52,9 +52,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.sparse.linalg import splu
 
 from ...errors import InputError, NumericalError
+from .factor import Factorisation, factorise
 from .mesh import BodyMesh
 
 __all__ = ["ElasticMaterial", "ElasticBody", "flank_points", "influence_matrices",
@@ -262,14 +262,17 @@ class ElasticBody:
             raise NumericalError("boundary segment not found among the mesh facets")
         return self._facet_order[pos]
 
-    def factor(self, *, release_matrix: bool = False):
-        """The SuperLU factorisation of the free-free stiffness (computed once).
+    def factor(self, *, release_matrix: bool = False, solver: str | None = None
+               ) -> Factorisation:
+        """The factorisation of the free-free stiffness (computed once; :func:`.factor.factorise`,
+        CHOLMOD where installed, SuperLU otherwise, or ``solver``).
 
         ``release_matrix=True`` drops the assembled stiffness ``K`` once its free-free part is
-        taken, before SuperLU allocates its factors: a caller that only solves with the body
+        taken, before the solver allocates its factors: a caller that only solves with the body
         afterwards (:func:`geardyn.stiffness.fe.model.body_influence`) lowers its peak memory
         by the matrix (measured on the paper's cracked pinion, 150,880 DOFs: both FE maps in
-        one process 682 -> 627 MB). The factorisation is the same; ``K`` is ``None`` after.
+        one process 682 -> 627 MB with SuperLU). The factorisation is the same; ``K`` is
+        ``None`` after.
         """
         from skfem import condense
 
@@ -278,27 +281,25 @@ class ElasticBody:
             kff = condense(self.K, D=self.fixed, expand=False).tocsc()
             if release_matrix:
                 self.K = None
-            self._lu = splu(kff, permc_spec="MMD_AT_PLUS_A",
-                            options={"SymmetricMode": True})
+            self._lu = factorise(kff, solver)
             del kff
             self.t_factor = time.perf_counter() - t0
         return self._lu
 
-    def solve(self, rhs: np.ndarray, block: int = 4) -> np.ndarray:
-        """Displacements [m] for loads ``rhs`` (n_dofs, n) [N/m per unit width], bore fixed.
+    @property
+    def solver(self) -> str | None:
+        """The solver that factorised the body (``"cholmod"`` or ``"superlu"``; None before)."""
+        return None if self._lu is None else self._lu.solver
 
-        The right-hand sides go to SuperLU ``block`` at a time: its multi-column solve slows
-        down per column as the block grows (measured on the paper pinion at refinement 0.5,
-        53,144 DOFs, 48 columns: 4.0 s in one call, 0.95 s one at a time, 0.70 s four at a
-        time, 1.3 s eight at a time); results agree to 2e-15 relative whatever the block.
-        """
+    def solve(self, rhs: np.ndarray) -> np.ndarray:
+        """Displacements [m] for loads ``rhs`` (n_dofs, n) or (n_dofs,) [N/m per unit width],
+        bore fixed (zero on the fixed DOFs)."""
         lu = self.factor()
         rhs = np.asarray(rhs, float)
         one = rhs.ndim == 1
         b = rhs[:, None] if one else rhs
         out = np.zeros((self.n_dofs, b.shape[1]))
-        for k in range(0, b.shape[1], block):
-            out[self.free, k:k + block] = lu.solve(np.asfortranarray(b[self.free, k:k + block]))
+        out[self.free] = lu.solve(b[self.free])
         return out[:, 0] if one else out
 
     # ---------------------------------------------------------------- flank loads and readouts
@@ -445,7 +446,8 @@ class BodyInfluence:
 
     def save(self, path) -> None:
         """Write to ``.npz`` (no pickle)."""
-        stats = np.array([[k, repr(v)] for k, v in self.stats.items()], dtype=str)
+        stats = np.array([[k, v if isinstance(v, str) else repr(v)]
+                          for k, v in self.stats.items()], dtype=str)
         extra = {} if self.u_teeth is None else {"u_teeth": self.u_teeth}
         with open(path, "wb") as fh:
             np.savez(fh, u=self.u, load_offsets=np.asarray(self.load_offsets),
@@ -518,7 +520,7 @@ def influence_matrices(body: ElasticBody, u: np.ndarray, half_width: float, *,
             progress(a + 1, len(load_offsets))
     stats = {"nodes": body.mesh.n_nodes, "triangles": body.mesh.n_triangles,
              "dofs": body.n_dofs, "t_assemble": body.t_assemble, "t_factor": body.t_factor,
-             "t_solve": time.perf_counter() - t0}
+             "t_solve": time.perf_counter() - t0, "solver": body.solver}
     u_teeth = np.stack([grids[j] for j in read]) if u_by_offset else None
     return BodyInfluence(u=np.asarray(u, float), load_offsets=tuple(load_offsets),
                          read_offsets=tuple(read), H=H, half_width=float(half_width),

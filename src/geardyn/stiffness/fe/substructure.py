@@ -40,10 +40,10 @@ import time
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.sparse.linalg import splu
 
 from ...errors import InputError, NumericalError
 from ...geometry import Gear
+from .factor import factorise
 from .mesh import (
     _GMSH_LOCK,
     BodyMesh,
@@ -451,14 +451,12 @@ class HealthySuperelement:
         K = body.K.tocsr()
         kii = condense(K, D=np.setdiff1d(np.arange(body.n_dofs), interior),
                        expand=False).tocsc()
-        lu = splu(kii, permc_spec="MMD_AT_PLUS_A", options={"SymmetricMode": True})
+        lu = factorise(kii)
         teeth = self.mesh.offsets
         F = np.hstack([body.patch_loads(j, self.u, self.half_width) for j in teeth])
         D = np.vstack([body.readout(j, self.u).toarray() for j in teeth])
         rhs = np.hstack([K[interior][:, self.gamma].toarray(), F[interior]])
-        x = np.empty_like(rhs)
-        for k in range(0, rhs.shape[1], 4):
-            x[:, k:k + 4] = lu.solve(np.asfortranarray(rhs[:, k:k + 4]))
+        x = lu.solve(rhs)
         ng = self.gamma.size
         kgi = K[self.gamma][:, interior]
         S = K[self.gamma][:, self.gamma].toarray() - kgi @ x[:, :ng]
@@ -475,7 +473,7 @@ class HealthySuperelement:
         self.offsets = tuple(int(j) for j in teeth)
         self.stats = {"nodes_H": self.mesh.n_nodes, "dofs_H": body.n_dofs,
                       "gamma_dofs": int(ng), "t_mesh_H": t_mesh,
-                      "t_condense_H": time.perf_counter() - t0 - t_mesh}
+                      "t_condense_H": time.perf_counter() - t0 - t_mesh, "solver_H": lu.solver}
 
     _ARRAYS = ("S", "G", "DX", "DY", "gamma_x", "gamma_c", "u")
 
@@ -489,7 +487,8 @@ class HealthySuperelement:
 
     def save(self, path) -> None:
         """Write the condensed arrays to ``.npz`` (no pickle; not the mesh of ``H``)."""
-        stats = np.array([[k, repr(v)] for k, v in self.stats.items()], dtype=str)
+        stats = np.array([[k, v if isinstance(v, str) else repr(v)]
+                          for k, v in self.stats.items()], dtype=str)
         with open(path, "wb") as fh:
             np.savez(fh, **{k: getattr(self, k) for k in self._ARRAYS},
                      n_gamma=np.int64(self.gamma.size), offsets=np.asarray(self.offsets),
@@ -564,7 +563,7 @@ class HealthySuperelement:
         cols = np.tile(gam_r, ng)
         K = (rb.K + sp.csr_matrix((self.S.ravel(), (rows, cols)),
                                   shape=rb.K.shape)).tocsc()
-        lu = splu(K, permc_spec="MMD_AT_PLUS_A", options={"SymmetricMode": True})
+        lu = factorise(K)
         t_factor = time.perf_counter() - t0 - t_mesh
 
         teeth_h = self.offsets
@@ -589,9 +588,7 @@ class HealthySuperelement:
                 k = teeth_h.index(i)
                 f = np.zeros((rb.n_dofs, n))
                 f[gam_r] = self.G[:, k * n:(k + 1) * n]
-            x = np.empty_like(f)
-            for c in range(0, n, 4):
-                x[:, c:c + 4] = lu.solve(np.asfortranarray(f[:, c:c + 4]))
+            x = lu.solve(f)
             H[a, jr] = read_r @ x
             dh = self.DX @ x[gam_r]
             if i != 0:
@@ -600,7 +597,7 @@ class HealthySuperelement:
                 H[a, jj] = dh[m * n:(m + 1) * n]
         stats = {"nodes_R": rmesh.n_nodes, "dofs_R": rb.n_dofs, "t_mesh_R": t_mesh,
                  "t_factor_R": t_factor, "t_total_R": time.perf_counter() - t0,
-                 **self.stats}
+                 "solver_R": lu.solver, **self.stats}
         u_teeth = None
         if u0 is not u:
             u_teeth = np.stack([u0 if j == 0 else u for j in offsets])
