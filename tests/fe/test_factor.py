@@ -120,3 +120,28 @@ def test_a_bad_right_hand_side_is_refused():
         fac.solve(np.ones(7))
     assert fac.solve(np.ones((8, 0))).shape == (8, 0)
     assert repr(fac) == "Factorisation(solver='superlu', n=8)"
+
+
+@needs_cholmod
+def test_a_factorisation_alive_at_exit_prints_nothing():
+    """A script that keeps a CHOLMOD factorisation to its end exits without cholespy's binding
+    printing "nanobind: leaked ..." (factor._release_all frees it at exit)."""
+    import subprocess
+    import sys
+
+    # a factorisation in a reference cycle, as a body's can be, with the collector frozen at
+    # exit as geardyn's own processes do (processes.skip_collection_at_exit)
+    code = ("import gc, numpy as np, scipy.sparse as sp\n"
+            "from geardyn.processes import skip_collection_at_exit\n"
+            "from geardyn.stiffness.fe.factor import factorise\n"
+            "class Body: pass\n"
+            "b = Body(); b.me = b\n"
+            "b.lu = factorise(sp.diags([2.0, 3.0, 4.0]).tocsc(), 'cholmod')\n"
+            "print(b.lu.solve(np.ones(3)))\n"
+            "del b\n"
+            "skip_collection_at_exit()\n")
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         timeout=120, check=False)
+    assert res.returncode == 0, res.stderr
+    assert "0.5" in res.stdout
+    assert "leaked" not in res.stderr, res.stderr

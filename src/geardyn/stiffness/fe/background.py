@@ -3,15 +3,17 @@ ones (issue 16.3: "the bodies built in parallel where cores allow").
 
 A cold pair of FE maps (healthy and faulty) solves three bodies one after the other: the healthy
 pinion and gear, then the faulty body (the cracked pinion, loaded on every refined tooth, the
-largest of the three). SuperLU holds the interpreter lock, so threads cannot overlap them; a
-second *process* can. :func:`faulty_bodies_in_background` starts one that builds the faulty map's
-bodies, faulty body first, into the disk cache, while the caller builds the healthy map. Each
+largest of the three). gmsh cannot mesh in two threads of one process at once, so threads
+would not overlap the bodies' meshing; a second *process* overlaps all of a body's work.
+:func:`faulty_bodies_in_background` starts one that builds the faulty map's bodies, faulty
+body first, into the disk cache, while the caller builds the healthy map. Each
 body's cache entry has a lock (:meth:`geardyn.cache.Cache.get_or_build`): whichever process comes
 to a body first builds it, the other waits for it and loads it. So the results are the same
 bytes as a one-process build, whatever the timing (``tests/fe/test_background_bodies.py``).
 
-It costs memory: two bodies are factorised at once (about 400 MB each for the paper's 150,880-DOF
-pinion). The second process starts only when
+It costs memory: two bodies are factorised at once (each process about 360 MB at its peak for
+the paper's 150,880-DOF pinion with CHOLMOD, 400-440 MB with SuperLU; docs/performance.md,
+2026-11-27). The second process starts only when
 
 * the case's stiffness method is ``fe``, its faulty map is not cached yet and it has a faulty
   body (a crack or a breakage), and the disk cache is on;
