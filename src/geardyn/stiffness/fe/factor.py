@@ -64,6 +64,12 @@ SOLVER_ENV = "GEARDYN_FE_SOLVER"
 #: 0.95 s one at a time, 0.70 s four at a time, 1.3 s eight at a time; measured 2026-11-24).
 SUPERLU_BLOCK = 4
 
+#: Right-hand sides per call to CHOLMOD's solve: its temporaries grow with the block (a
+#: superelement's condensation solves hundreds of columns at once), its speed per column no
+#: longer beyond about 8 (the paper pinion, 48 columns: 1.65 s one at a time, 0.80 s four,
+#: 0.65 s eight, 0.66 s sixteen, 0.65-0.71 s all at once; measured 2026-11-27).
+CHOLMOD_BLOCK = 32
+
 
 #: CHOLMOD factorisations alive in this process (released at its exit: :func:`_release_all`)
 _LIVE: weakref.WeakSet = weakref.WeakSet()
@@ -149,9 +155,16 @@ class Factorisation:
         if b.ndim == 2 and b.shape[1] == 0:
             return np.zeros_like(b)
         if self.solver == "cholmod":
-            b = np.ascontiguousarray(b)
-            x = np.empty_like(b)
-            self._impl.solve(b, x)
+            if b.ndim == 1:
+                x = np.empty_like(b)
+                self._impl.solve(np.ascontiguousarray(b), x)
+                return x
+            x = np.empty(b.shape)
+            for k in range(0, b.shape[1], CHOLMOD_BLOCK):
+                part = np.ascontiguousarray(b[:, k:k + CHOLMOD_BLOCK])
+                xk = np.empty_like(part)
+                self._impl.solve(part, xk)
+                x[:, k:k + CHOLMOD_BLOCK] = xk
             return x
         if b.ndim == 1:
             return self._impl.solve(b)
