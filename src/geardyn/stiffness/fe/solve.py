@@ -446,8 +446,7 @@ class BodyInfluence:
 
     def save(self, path) -> None:
         """Write to ``.npz`` (no pickle)."""
-        stats = np.array([[k, v if isinstance(v, str) else repr(v)]
-                          for k, v in self.stats.items()], dtype=str)
+        stats = stats_to_array(self.stats)
         extra = {} if self.u_teeth is None else {"u_teeth": self.u_teeth}
         with open(path, "wb") as fh:
             np.savez(fh, u=self.u, load_offsets=np.asarray(self.load_offsets),
@@ -459,13 +458,25 @@ class BodyInfluence:
     def load(cls, path) -> BodyInfluence:
         """Read a file written by :meth:`save`."""
         with np.load(path, allow_pickle=False) as d:
-            stats = {str(k): float(v) if _isfloat(v) else str(v) for k, v in d["stats"]}
+            stats = stats_from_array(d["stats"])
             return cls(u=d["u"].copy(), load_offsets=tuple(int(v) for v in d["load_offsets"]),
                        read_offsets=tuple(int(v) for v in d["read_offsets"]), H=d["H"].copy(),
                        half_width=float(d["half_width"]), plane_modulus=float(d["plane_modulus"]),
                        stats=stats,
                        inputs_hash=str(d["inputs_hash"]) if "inputs_hash" in d.files else "",
                        u_teeth=d["u_teeth"].copy() if "u_teeth" in d.files else None)
+
+
+def stats_to_array(stats: dict) -> np.ndarray:
+    """A ``stats`` dict (numbers and strings) as an (n, 2) string array for ``.npz`` files
+    without pickle: numbers by ``repr``, strings as they are (:func:`stats_from_array`)."""
+    return np.array([[k, v if isinstance(v, str) else repr(v)] for k, v in stats.items()],
+                    dtype=str)
+
+
+def stats_from_array(arr) -> dict:
+    """The ``stats`` dict :func:`stats_to_array` stored: numbers back as floats."""
+    return {str(k): float(v) if _isfloat(v) else str(v) for k, v in arr}
 
 
 def _isfloat(v) -> bool:

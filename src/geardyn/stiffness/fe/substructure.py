@@ -61,7 +61,13 @@ from .mesh import (
     split_body_crack,
     tooth_offsets,
 )
-from .solve import BodyInfluence, ElasticBody, ElasticMaterial, _isfloat
+from .solve import (
+    BodyInfluence,
+    ElasticBody,
+    ElasticMaterial,
+    stats_from_array,
+    stats_to_array,
+)
 
 __all__ = ["build_part_mesh", "glue_meshes", "HealthySuperelement", "interface_radius"]
 
@@ -487,8 +493,7 @@ class HealthySuperelement:
 
     def save(self, path) -> None:
         """Write the condensed arrays to ``.npz`` (no pickle; not the mesh of ``H``)."""
-        stats = np.array([[k, v if isinstance(v, str) else repr(v)]
-                          for k, v in self.stats.items()], dtype=str)
+        stats = stats_to_array(self.stats)
         with open(path, "wb") as fh:
             np.savez(fh, **{k: getattr(self, k) for k in self._ARRAYS},
                      n_gamma=np.int64(self.gamma.size), offsets=np.asarray(self.offsets),
@@ -511,7 +516,7 @@ class HealthySuperelement:
             self.half_width = float(d["half_width"])
             self.n_points = int(d["n_points"])
             self.fraction = float(d["fraction"])
-            self.stats = {str(k): float(v) if _isfloat(v) else str(v) for k, v in d["stats"]}
+            self.stats = stats_from_array(d["stats"])
             self.inputs_hash = str(d["inputs_hash"])
             self.H0 = d["H0"].copy() if "H0" in d.files else None
         self.gear, self.material, self.settings = gear, material, settings
