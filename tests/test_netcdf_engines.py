@@ -9,6 +9,7 @@ skipped where the two clash (importing it would break h5py in this process).
 
 from __future__ import annotations
 
+import json
 import subprocess
 import sys
 import textwrap
@@ -109,6 +110,30 @@ def test_groups_written_by_either_engine_read_the_same(tmp_path, writer, reader)
     with xr.open_dataset(path, engine=reader) as a, \
             xr.open_dataset(path, engine=reader, group="diagnostics/model_II") as b:
         xr.testing.assert_identical(a.load(), root)
+        xr.testing.assert_identical(b.load(), group)
+
+
+@pytest.mark.parametrize("writer, reader", [("netcdf4", "h5netcdf"), ("h5netcdf", "netcdf4")])
+def test_root_attributes_set_afterwards_read_as_if_written_with_the_file(engine, tmp_path,
+                                                                          writer, reader):
+    """:func:`geardyn.io.set_netcdf_attrs` (results.nc's summary, set on a cached copy): the
+    file reads, with either engine, as the same datasets written with the attribute."""
+    needs_netcdf4()
+    engine(writer)
+    summary = json.dumps({"run_time_s": {"stiffness": 0.5}, "path": "/tmp/x \u03b8",
+                          "long": "y" * 70_000})  # past HDF5's 64 kB compact attribute limit
+    root = xr.Dataset({"table": ("row", np.arange(4.0))}, attrs={"title": "tables",
+                                                                 "summary_json": "old"})
+    group = record()
+    path = tmp_path / "results.nc"
+    io.to_netcdf(root.drop_attrs(), path, mode="w")
+    io.to_netcdf(group, path, mode="a", group="diagnostics/model_II")
+    io.set_netcdf_attrs(path, {"title": "tables", "summary_json": "old"})
+    io.set_netcdf_attrs(path, {"summary_json": summary})  # replaces an existing attribute
+    engine(reader)  # (h5netcdf as the writer blocked the import of netCDF4)
+    with xr.open_dataset(path, engine=reader) as a, \
+            xr.open_dataset(path, engine=reader, group="diagnostics/model_II") as b:
+        xr.testing.assert_identical(a.load(), root.assign_attrs(summary_json=summary))
         xr.testing.assert_identical(b.load(), group)
 
 

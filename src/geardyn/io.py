@@ -27,7 +27,7 @@ import socket
 import tempfile
 import threading
 import time
-from collections.abc import Iterable, Iterator
+from collections.abc import Iterable, Iterator, Mapping
 from pathlib import Path
 
 from .errors import DataFileError
@@ -305,6 +305,36 @@ def to_netcdf(ds, path: str | os.PathLike, **kwargs) -> None:
     (``kwargs``: xarray's ``mode``, ``group``, ``encoding``...)."""
     with NETCDF_LOCK:
         ds.to_netcdf(path, engine=netcdf_engine(), **kwargs)
+
+
+def set_netcdf_attrs(path: str | os.PathLike, attrs: Mapping[str, str]) -> None:
+    """Set global (root group) text attributes of an existing NetCDF-4 file in place, through
+    the library :func:`netcdf_engine` names, as xarray's ``to_netcdf`` sets them.
+
+    For a file copied from the cache whose bytes are a function of its inputs but for a few
+    attributes of the run that wrote it (its run times and output paths): the caller copies
+    into a temporary path, sets them here, then renames it.
+
+    Parameters
+    ----------
+    path : path-like
+        An existing NetCDF-4 file, opened for appending.
+    attrs : mapping of str to str
+        Attribute name -> value; an existing attribute of that name is replaced.
+    """
+    with NETCDF_LOCK:
+        if netcdf_engine() == "netcdf4":
+            import netCDF4
+
+            with netCDF4.Dataset(os.fspath(path), "a") as nc:
+                for key, value in attrs.items():
+                    nc.setncattr(key, value)
+        else:
+            import h5netcdf
+
+            with h5netcdf.File(os.fspath(path), "a") as f:
+                for key, value in attrs.items():
+                    f.attrs[key] = value
 
 
 def write_netcdf_atomic(ds, path: str | os.PathLike) -> None:

@@ -297,7 +297,9 @@ def test_a_warm_run_into_a_new_folder_recomputes_nothing(tmp_path, monkeypatch):
         a = run_paper_study(case, tmp_path / "a", quick=True, stiffness="pem")
     cold = _counts(cold)
     assert cold["diagnosis"] == {"hits": 0, "built": 6}  # models I, I-static, II x 2 states
-    assert cold["figure"]["hits"] == 0 and cold["output"] == {"hits": 0, "built": 9}
+    # the output files: the run records, the two maps and results.nc (since 2026-11-28: one
+    # entry, each run's own summary set on its copy)
+    assert cold["figure"]["hits"] == 0 and cold["output"] == {"hits": 0, "built": 10}
     assert cold["map values"] == {"hits": 0, "built": 1}
 
     def no_diagnosis(**_kw):
@@ -309,7 +311,7 @@ def test_a_warm_run_into_a_new_folder_recomputes_nothing(tmp_path, monkeypatch):
     warm = _counts(warm)
     assert warm["figure"] == {"hits": cold["figure"]["built"], "built": 0}
     assert warm["diagnosis"] == {"hits": 6, "built": 0}
-    assert warm["output"] == {"hits": 9, "built": 0}
+    assert warm["output"] == {"hits": 10, "built": 0}
     assert warm["map values"] == {"hits": 1, "built": 0}
     assert all(v["built"] == 0 for v in warm.values()), warm
 
@@ -332,6 +334,18 @@ def test_a_warm_run_into_a_new_folder_recomputes_nothing(tmp_path, monkeypatch):
         assert filecmp.cmp(a.out / p, b.out / p, shallow=False), p
     with h5py.File(a.out / "results.nc") as fa, h5py.File(b.out / "results.nc") as fb:
         _h5_equal(fa, fb)
+    # each copy holds its own run's summary (its stage times), readable by xarray
+    for r, s in ((a, sa), (b, sb)):
+        with xr.open_dataset(r.out / "results.nc") as ds:
+            own = json.loads(ds.attrs["summary_json"])
+        times = json.loads((r.out / "summary.json").read_text())["run_time_s"]
+        assert own.pop("run_time_s") == {k: times[k] for k in times
+                                         if k not in ("report", "total")}
+        # (results.nc is written as the report stage starts: "complete" and "stages" are
+        # the summary's then)
+        assert own.pop("stages") == s["stages"][:-1] and s["stages"][-1] == "report"
+        assert own.pop("complete") is False and s["complete"] is True
+        assert own == {k: v for k, v in s.items() if k in own} and len(own) >= len(s) - 3
 
     # the cached numbers read off the maps are the maps' own (computed directly here)
     from geardyn.stiffness.plots import crack_angle

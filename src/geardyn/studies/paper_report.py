@@ -17,7 +17,7 @@ import numpy as np
 
 from .._version import __version__, package_versions
 from ..config import Case, case_to_toml
-from ..io import atomic_path, json_safe, to_netcdf
+from ..io import atomic_path, json_safe, set_netcdf_attrs, to_netcdf
 from .paper_report_case import (  # noqa: F401 - re-exported: the tests read the case table
     _case_table_rows,
     _difference_text,
@@ -391,17 +391,33 @@ def write_results_netcdf(path: Path, result: StudyResult, case: Case) -> None:
 
     See :data:`RESULTS_LAYOUT`. The simulated records are not repeated here: they are
     ``runs/model_<M>_<state>.nc``, one file per run.
+
+    The file goes through the output cache (:func:`.paper_cache.write_output`, keyed by every
+    group's dataset and the encoding), all but the root's ``summary_json``: it holds this
+    run's stage times and output paths, so it is set on the copy
+    (:func:`geardyn.io.set_netcdf_attrs`) before the copy is renamed into place. A run into
+    another folder with the same results then copies the bytes instead of writing the nine
+    groups again (1.0-1.2 s of a 5 s warm ``geardyn run``, measured 2026-11-28).
     """
+    from .paper_cache import write_output
+
     root = _tables_dataset(result, case)
-    with atomic_path(path, suffix=".nc") as tmp:
-        to_netcdf(root, tmp, mode="w", encoding=_compressed(root))
-        for state, m in result.maps.items():
-            ds = m.to_dataset()
-            to_netcdf(ds, tmp, mode="a", group=f"stiffness/{state}", encoding=_compressed(ds))
-        for (model, state), diag in result.diagnoses.items():
-            ds = _diagnosis_dataset(diag)
-            to_netcdf(ds, tmp, mode="a", group=f"diagnostics/model_{model}_{state}",
+    summary = root.attrs.pop("summary_json")
+    groups = [("", root)]
+    groups += [(f"stiffness/{state}", m.to_dataset()) for state, m in result.maps.items()]
+    groups += [(f"diagnostics/model_{model}_{state}", _diagnosis_dataset(diag))
+               for (model, state), diag in result.diagnoses.items()]
+
+    def write(tmp: Path) -> None:
+        for i, (group, ds) in enumerate(groups):
+            to_netcdf(ds, tmp, mode="a" if i else "w", group=group or None,
                       encoding=_compressed(ds))
+
+    with atomic_path(path, suffix=".nc") as tmp:
+        write_output(tmp, "results", [(group, ds, list(ds.variables)) for group, ds in groups],
+                     {"compression": "zlib 4 shuffle, numeric arrays", "layout": "groups"},
+                     write)
+        set_netcdf_attrs(tmp, {"summary_json": summary})
 
 
 def _diagnosis_dataset(diag):
