@@ -25,7 +25,8 @@ def _two_pulse_record(path, stated: bool):
 def test_the_files_pulse_count_is_the_default_and_a_contradiction_is_refused(tmp_path):
     stated = _two_pulse_record(tmp_path / "stated.nc", True)
     plain = _two_pulse_record(tmp_path / "plain.nc", False)
-    common = ["--signal", "acc", "--tach", "tach", "--teeth", 25, *SMALL]
+    # (metrics only: the figures are another test's business)
+    common = ["--signal", "acc", "--tach", "tach", "--teeth", 25, "--no-figures", *SMALL]
     r = run(tmp_path, stated, *common, "--out", tmp_path / "a")
     assert r.returncode == 0, r.stdout + r.stderr
     r = run(tmp_path, plain, *common, "--pulses-per-rev", 2, "--out", tmp_path / "b")
@@ -66,7 +67,7 @@ def test_a_csv_of_geardyn_measure_states_its_rate_teeth_and_pulses(tmp_path):
     assert "# fs = 10000 Hz" in text and "# pinion_teeth = 25" in text
     for name in ("rec.nc", "rec.csv"):
         r = run(tmp_path, tmp_path / name, "--signal", "acc", "--tach", "tach", *SMALL,
-                "--out", tmp_path / name.replace(".", "-"))
+                "--no-figures", "--out", tmp_path / name.replace(".", "-"))
         assert r.returncode == 0, r.stdout + r.stderr
         assert "(teeth 25)" in r.stdout + r.stderr
     a, b = metrics(tmp_path / "rec-nc"), metrics(tmp_path / "rec-csv")
@@ -100,7 +101,7 @@ def test_options_that_would_be_ignored_are_refused(tmp_path):
         assert line.startswith(f"error: {extra[0]}: got") and "--tach" in line, line
     # the same files without those options are diagnosed
     r = run(tmp_path, ang, "--signal", "acc", "--angle", "angle", "--time", "time", "--teeth",
-            25, *SMALL, "--out", tmp_path / "ok")
+            25, *SMALL, "--no-figures", "--out", tmp_path / "ok")
     assert r.returncode == 0, r.stdout + r.stderr
 
 
@@ -114,7 +115,8 @@ def test_a_simulations_own_teeth_cannot_be_contradicted(tmp_path):
     line = one_error(run(tmp_path, sim, "--signal", "v_yg", "--teeth", 31, *SMALL,
                          "--out", tmp_path / "o"))
     assert line.startswith("error: --teeth: got 31") and "theta_p" in line and "25" in line
-    r = run(tmp_path, sim, "--signal", "v_yg", "--teeth", 25, *SMALL, "--out", tmp_path / "ok")
+    r = run(tmp_path, sim, "--signal", "v_yg", "--teeth", 25, *SMALL, "--no-figures",
+            "--out", tmp_path / "ok")
     assert r.returncode == 0, r.stdout + r.stderr
 
 
