@@ -85,3 +85,50 @@ def test_bad_input_exits_2(tmp_path, args, words):
     assert r.exit_code == 2, r.output
     assert words in r.output
     assert "Traceback" not in r.output
+
+
+def test_a_second_write_copies_every_file_and_draws_nothing(tmp_path, monkeypatch):
+    """``geardyn stiffness`` writes its maps and figures through the output cache: into another
+    folder the same maps give the same bytes, copied, with no figure drawn and (FE) no body
+    meshed again; a map of other values is drawn anew."""
+    import filecmp
+
+    import geardyn.stiffness.fe as fe
+    import geardyn.stiffness.plots as plots
+    from geardyn import paper_case
+    from geardyn.cache import record_lookups
+    from geardyn.cli.stiffness import _write_outputs
+    from geardyn.stiffness import build_map
+
+    monkeypatch.setenv("GEARDYN_CACHE_DIR", str(tmp_path / "cache"))
+    case = paper_case(["stiffness.method=pem", "stiffness.centre_distances=3",
+                       "stiffness.nodes_per_segment=8", "stiffness.fe.refinement=0.25"])
+    maps = {"healthy": build_map(case, method="pem", cracked=False),
+            "cracked": build_map(case, method="pem", cracked=True)}
+    files = ["stiffness_healthy.nc", "stiffness_cracked.nc", "fig5_stiffness.png",
+             "fig5_load_sharing.png", "fig6_crack.png", "fe_mesh.png"]
+    with record_lookups() as first:
+        assert _write_outputs(tmp_path / "a", case, maps, "fe", True) == files
+    assert [r["hit"] for r in first if r["kind"] == "output"] == [False] * 6
+
+    def never(*_a, **_k):
+        raise AssertionError("drawn again")
+
+    for name in ("fig_stiffness", "fig_load_sharing", "fig_crack"):
+        monkeypatch.setattr(plots, name, never)
+    monkeypatch.setattr(fe, "plot_mesh", never)
+    with record_lookups() as second:
+        assert _write_outputs(tmp_path / "b", case, maps, "fe", True) == files
+    assert [r["hit"] for r in second if r["kind"] == "output"] == [True] * 6
+    for name in files:
+        assert filecmp.cmp(tmp_path / "a" / name, tmp_path / "b" / name, shallow=False), name
+    # a cracked map of other values: its file and Fig. 6 anew (the healthy ones copied)
+    other = {"healthy": maps["healthy"],
+             "cracked": build_map(case.with_overrides({"crack.depth": "3 mm"}), method="pem",
+                                  cracked=True)}
+    with pytest.raises(AssertionError, match="drawn again"):
+        _write_outputs(tmp_path / "c", case, other, "pem", True)
+    assert filecmp.cmp(tmp_path / "a" / "fig5_stiffness.png", tmp_path / "c" / "fig5_stiffness.png",
+                       shallow=False)
+    assert not filecmp.cmp(tmp_path / "a" / "stiffness_cracked.nc",
+                           tmp_path / "c" / "stiffness_cracked.nc", shallow=False)
