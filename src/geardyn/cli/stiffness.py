@@ -57,7 +57,7 @@ def _write_outputs(out: Path, case, maps: dict, method: str, has_crack: bool) ->
     (the maps; for ``fe_mesh.png`` the case and whether it is cracked), the matplotlib
     version and the resolution. A run whose maps came from the cache then copies the files
     an earlier run wrote instead of encoding the maps, meshing the body again for the mesh
-    figure and drawing the figures: 8.2 s -> 3.0 s for the paper's FE maps (2026-11-28, see
+    figure and drawing the figures: 8.2 s -> 2.5-2.7 s for the paper's FE maps (2026-11-28, see
     the README's performance section).
     """
     from importlib.metadata import version
