@@ -45,69 +45,6 @@ RESULTS = ["stiffness_healthy.nc", "stiffness_cracked.nc", "fig5_stiffness.png",
            "fig_faults.png"]
 
 
-#: PNG resolution of the figures ``geardyn stiffness`` writes [dots per inch].
-FIGURE_DPI = 150
-
-
-def _write_outputs(out: Path, case, maps: dict, method: str, has_crack: bool) -> list[str]:
-    """The maps (NetCDF) and the figures (PNG) into ``out``; returns the file names.
-
-    Each file goes through the output cache (:func:`geardyn.studies.paper_cache.write_output`):
-    a map under the same key as ``geardyn run`` writes it, a figure keyed by what it draws
-    (the maps; for ``fe_mesh.png`` the case and whether it is cracked), the matplotlib
-    version and the resolution. A run whose maps came from the cache then copies the files
-    an earlier run wrote instead of encoding the maps, meshing the body again for the mesh
-    figure and drawing the figures: 8.2 s -> 2.5-2.7 s for the paper's FE maps (2026-11-28, see
-    the README's performance section).
-    """
-    from importlib.metadata import version
-
-    from ..config import case_to_toml
-    from ..studies.paper_cache import write_output
-
-    written = []
-    for name, m in maps.items():  # the same key as geardyn run's copies of the maps
-        write_output(out / f"stiffness_{name}.nc", "stiffness map", m, "StiffnessMap.to_netcdf",
-                     m.to_netcdf)
-        written.append(f"stiffness_{name}.nc")
-
-    def figure(name: str, data, draw) -> None:
-        def write(path: Path) -> None:
-            draw().savefig(path, dpi=FIGURE_DPI, format="png")
-
-        write_output(out / name, f"geardyn stiffness figure {name}", data,
-                     {"dpi": FIGURE_DPI, "format": "png", "matplotlib": version("matplotlib")},
-                     write)
-        written.append(name)
-
-    def plots():  # matplotlib imported only where a figure is drawn
-        from ..stiffness import plots
-
-        return plots
-
-    healthy = maps["healthy"]
-    figure("fig5_stiffness.png", healthy, lambda: plots().fig_stiffness(healthy))
-    figure("fig5_load_sharing.png", healthy, lambda: plots().fig_load_sharing(healthy))
-    if "cracked" in maps:
-        figure("fig6_crack.png", (healthy, maps["cracked"]),
-               lambda: plots().fig_crack(healthy, maps["cracked"]))
-    if "faulty" in maps:
-        def faults():
-            from ..faults.figures import fig_faults
-
-            return fig_faults(healthy, maps["faulty"])
-
-        figure("fig_faults.png", (healthy, maps["faulty"]), faults)
-    if method == "fe":
-        def mesh():
-            from ..stiffness.fe import plot_mesh
-
-            return plot_mesh(case, cracked=has_crack)
-
-        figure("fe_mesh.png", (case_to_toml(case), has_crack), mesh)
-    return written
-
-
 @app.command("stiffness")
 @handle_errors
 def stiffness(
@@ -153,34 +90,42 @@ def stiffness(
 
     from ..cache import record_lookups
     from ..stiffness import build_map
+    from ..studies.stiffness_outputs import write_stiffness_outputs
 
-    maps = {}
-    with progress_bar() as bar, warnings.catch_warnings(), record_lookups() as lookups, \
-            contextlib.ExitStack() as stack:
-        # the maps carry their validity notes in attrs["warnings"]; printed below once
-        warnings.simplefilter("ignore", UserWarning)
-        progress = StageProgress(bar)
-        if method == "fe":  # a second process builds the faulty bodies meanwhile where cores
-            # and memory allow; else this one builds them first (the largest body while the
-            # process is smallest)
-            from ..stiffness.fe.background import faulty_bodies_in_background
+    # one record from the first map to the last file: an entry the second process builds
+    # meanwhile (a body, the mesh figure) counts as built by this run, not as reused
+    with record_lookups() as lookups:
+        maps = {}
+        with progress_bar() as bar, warnings.catch_warnings(), contextlib.ExitStack() as stack:
+            # the maps carry their validity notes in attrs["warnings"]; printed below once
+            warnings.simplefilter("ignore", UserWarning)
+            progress = StageProgress(bar)
+            if method == "fe":  # a second process builds the faulty bodies meanwhile where
+                # cores and memory allow, then draws fe_mesh.png from the cracked body's mesh
+                # it holds; else this one builds them first (the largest body while the process
+                # is smallest)
+                from functools import partial
 
-            stack.enter_context(faulty_bodies_in_background(
-                case, method=method, progress=progress.stage("fe map, faulty bodies first")))
-        for name, cracked in (("healthy", False), ("faulty" if has_faults else "cracked", True)):
-            if cracked and not (has_crack or has_faults):
-                continue
-            label = f"{method} map, {name}"
-            progress(label, 0, 0)  # visible at once (an FE mesh comes before any count)
-            maps[name] = build_map(case, method=method, cracked=cracked,
-                                   progress=progress.stage(label))
-        progress.close()
+                from ..stiffness.fe.background import faulty_bodies_in_background
+                from ..studies.stiffness_outputs import fe_mesh_png_task
 
-    say_state(state, target)
-    begin(target, ident)
-    with record_lookups() as written_lookups:
-        written = _write_outputs(out, case, maps, method, has_crack)
-    lookups = [*lookups, *written_lookups]
+                then = (partial(fe_mesh_png_task, case, has_crack),) if has_crack else ()
+                stack.enter_context(faulty_bodies_in_background(
+                    case, method=method, then=then,
+                    progress=progress.stage("fe map, faulty bodies first")))
+            for name, cracked in (("healthy", False),
+                                  ("faulty" if has_faults else "cracked", True)):
+                if cracked and not (has_crack or has_faults):
+                    continue
+                label = f"{method} map, {name}"
+                progress(label, 0, 0)  # visible at once (an FE mesh comes before any count)
+                maps[name] = build_map(case, method=method, cracked=cracked,
+                                       progress=progress.stage(label))
+            progress.close()
+
+        say_state(state, target)
+        begin(target, ident)
+        written = write_stiffness_outputs(out, case, maps, method, has_crack)
 
     from rich.markup import escape
     from rich.table import Table

@@ -43,7 +43,7 @@ import numpy as np
 from ..config import Case, case_to_toml, paper_case
 from ..geometry import geometry_summary, static_operating_point
 from ..io import write_json_atomic, write_text_atomic
-from .paper_result import FigureStore, ImportedOnCall, Progress, StudyResult
+from .paper_result import PLOT_MESH, FigureStore, ImportedOnCall, Progress, StudyResult
 from .paper_validation import validation_tables
 from .paper_values import (
     CONDITION_METRICS,
@@ -112,19 +112,26 @@ def _faulty_bodies_in_background(case: Case, result: StudyResult):
     the FE method (the FE package takes 0.2 s to import). Without a second process it builds
     the faulty map's bodies first, under the progress bar ``stiffness (FE bodies)``."""
     import contextlib
+    from functools import partial
+
+    from .paper_result import fe_mesh_figure_task
 
     if case.stiffness.method != "fe":
         return contextlib.nullcontext(None)
     from ..stiffness.fe.background import faulty_bodies_in_background, tasks_in_background
 
     progress = result.sub_progress("stiffness (FE bodies)")
+    # after its bodies the second process draws the mesh figure from the cracked body's mesh
+    # it holds (this one would mesh the body again to draw it: about 1.5 s on the paper's pinion)
+    cracked = case.crack is not None and case.crack.active
+    mesh_figure = (partial(fe_mesh_figure_task, case, cracked),) if cracked else ()
     if not result.quick:
-        # the second process compiles the time-step kernel after its bodies, while this one
-        # evaluates the maps and goes on, or loads it from numba's cache (0.3 s) where it is
-        # there already; asking numba's cache here would import numba (53 MB) into this
-        # process before its own bodies' factorisations, the peak of the run's memory
+        # then it compiles the time-step kernel, while this one evaluates the maps and goes on,
+        # or loads it from numba's cache (0.3 s) where it is there already; asking numba's
+        # cache here would import numba (53 MB) into this process before its own bodies'
+        # factorisations, the peak of the run's memory
         return faulty_bodies_in_background(
-            case, then=(ImportedOnCall("geardyn.dynamics.warm", "compile_kernels"),),
+            case, then=(*mesh_figure, ImportedOnCall("geardyn.dynamics.warm", "compile_kernels")),
             progress=progress)
     from ..dynamics.warm import compile_kernels, kernels_compiled
 
@@ -139,9 +146,9 @@ def _faulty_bodies_in_background(case: Case, result: StudyResult):
         if result.kernel_compiler is not None:
             result.background.append(result.kernel_compiler)
         return faulty_bodies_in_background(case, progress=progress, second_process=False)
-    # --quick with the kernel compiled: the second process ends with the bodies (loading the
-    # kernel there would not load it here) and the block waits for it
-    return faulty_bodies_in_background(case, progress=progress)
+    # --quick with the kernel compiled: the second process ends with the bodies and the mesh
+    # figure (loading the kernel there would not load it here)
+    return faulty_bodies_in_background(case, then=mesh_figure, progress=progress)
 
 
 def _figure_process(result: StudyResult):
@@ -207,12 +214,12 @@ def stiffness_stage(case: Case, out: Path, result: StudyResult) -> None:
         fingerprint("fig5_load_sharing curves", healthy), lambda: load_sharing_curves(healthy)))
     if case.stiffness.method == "fe":
         # imported only to draw: the FE package takes 0.2 s to import (issue 16)
-        plot_mesh = ImportedOnCall("geardyn.stiffness.fe", "plot_mesh")
-        # the mesh the maps were built on (with --quick, the coarser one, which is also the one
-        # build_body_mesh has just made and still holds: drawn here, not by a figure process,
-        # which would mesh the body again)
+        # the mesh the maps were built on (with --quick, the coarser one), drawn by the process
+        # that holds it: the second process that built the cracked body draws it into the
+        # cache ahead (fe_mesh_figure_task), else this one, which built it; not the figure
+        # process, which would mesh the body again
         result.summary["fe_mesh_refinement"] = float(map_case.stiffness.fe.refinement)
-        result.figures.cached_here("fig_fe_mesh", plot_mesh, map_case,
+        result.figures.cached_here("fig_fe_mesh", PLOT_MESH, map_case,
                                    cracked=case.crack is not None and case.crack.active)
     cracks = case.crack is not None and case.crack.active
     dd_op = result.summary.get("static", {}).get("centre_distance_change_mm", 0.0) * 1e-3

@@ -298,6 +298,29 @@ class ImportedOnCall:
                                                                                    **kwargs)
 
 
+#: The drawing function of the study's FE mesh figure (``fig_fe_mesh``): the figure cache keys
+#: the figure by its name, so the study and the second process that draws it ahead
+#: (:func:`fe_mesh_figure_task`) must both use this one.
+PLOT_MESH = ImportedOnCall("geardyn.stiffness.fe", "plot_mesh")
+
+
+def fe_mesh_figure_task(map_case, cracked: bool) -> None:
+    """The study's FE mesh figure (``fig_fe_mesh``) into the figure cache, for the second
+    process to call right after it has built the faulty bodies (a ``then`` task of
+    :func:`geardyn.stiffness.fe.background.faulty_bodies_in_background`): it holds the cracked
+    body's mesh, so it draws the figure without meshing again (about 1.5 s of gmsh on the
+    paper's pinion) while the first process evaluates the maps; the first then reads it from
+    the cache (or waits for it there, under the entry's lock).
+
+    A failure here is left to the first process, which draws the figure itself and meets (and
+    reports) the same error.
+    """
+    import contextlib
+
+    with contextlib.suppress(Exception):
+        FigureStore().cached_here("fig_fe_mesh", PLOT_MESH, map_case, cracked=cracked)
+
+
 class _Pending:
     """A figure handed to the figure process, or held for it: its name and cache key, how to
     draw it here, and the PNG to come (``future``, None while held). The arguments are let go

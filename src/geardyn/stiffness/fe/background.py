@@ -182,9 +182,11 @@ def faulty_bodies_in_background(case, *, method: str | None = None, cache=None,
     those bodies).
 
     ``method`` is the stiffness method the block builds its maps with (default the case's);
-    anything but ``"fe"`` starts nothing. ``then``: module-level functions (no arguments) the
-    second process calls after the bodies, e.g. :func:`geardyn.dynamics.warm.compile_kernels`
-    (compiled while the first process evaluates the maps and goes on). Yields a
+    anything but ``"fe"`` starts nothing. ``then``: callables without arguments (module-level
+    functions, or a ``functools.partial`` of one with picklable arguments) the second process
+    calls after the bodies, e.g. :func:`geardyn.dynamics.warm.compile_kernels` (compiled while
+    the first process evaluates the maps and goes on) or a figure of the faulty body's mesh,
+    which it holds then (:func:`geardyn.studies.stiffness_outputs.fe_mesh_png_task`). Yields a
     :class:`BackgroundBodies`. On leaving the block normally it waits for the process (whose
     bodies the block has then usually loaded already), unless there is ``then`` work, which goes
     on after the block; on an exception (Ctrl-C included) it stops the process at once. The
