@@ -97,8 +97,8 @@ def test_a_second_write_copies_every_file_and_draws_nothing(tmp_path, monkeypatc
     import geardyn.stiffness.plots as plots
     from geardyn import paper_case
     from geardyn.cache import record_lookups
-    from geardyn.cli.stiffness import _write_outputs
     from geardyn.stiffness import build_map
+    from geardyn.studies.stiffness_outputs import write_stiffness_outputs
 
     monkeypatch.setenv("GEARDYN_CACHE_DIR", str(tmp_path / "cache"))
     case = paper_case(["stiffness.method=pem", "stiffness.centre_distances=3",
@@ -108,7 +108,7 @@ def test_a_second_write_copies_every_file_and_draws_nothing(tmp_path, monkeypatc
     files = ["stiffness_healthy.nc", "stiffness_cracked.nc", "fig5_stiffness.png",
              "fig5_load_sharing.png", "fig6_crack.png", "fe_mesh.png"]
     with record_lookups() as first:
-        assert _write_outputs(tmp_path / "a", case, maps, "fe", True) == files
+        assert write_stiffness_outputs(tmp_path / "a", case, maps, "fe", True) == files
     assert [r["hit"] for r in first if r["kind"] == "output"] == [False] * 6
 
     def never(*_a, **_k):
@@ -118,7 +118,7 @@ def test_a_second_write_copies_every_file_and_draws_nothing(tmp_path, monkeypatc
         monkeypatch.setattr(plots, name, never)
     monkeypatch.setattr(fe, "plot_mesh", never)
     with record_lookups() as second:
-        assert _write_outputs(tmp_path / "b", case, maps, "fe", True) == files
+        assert write_stiffness_outputs(tmp_path / "b", case, maps, "fe", True) == files
     assert [r["hit"] for r in second if r["kind"] == "output"] == [True] * 6
     for name in files:
         assert filecmp.cmp(tmp_path / "a" / name, tmp_path / "b" / name, shallow=False), name
@@ -127,7 +127,7 @@ def test_a_second_write_copies_every_file_and_draws_nothing(tmp_path, monkeypatc
              "cracked": build_map(case.with_overrides({"crack.depth": "3 mm"}), method="pem",
                                   cracked=True)}
     with pytest.raises(AssertionError, match="drawn again"):
-        _write_outputs(tmp_path / "c", case, other, "pem", True)
+        write_stiffness_outputs(tmp_path / "c", case, other, "pem", True)
     assert filecmp.cmp(tmp_path / "a" / "fig5_stiffness.png", tmp_path / "c" / "fig5_stiffness.png",
                        shallow=False)
     assert not filecmp.cmp(tmp_path / "a" / "stiffness_cracked.nc",

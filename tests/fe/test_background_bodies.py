@@ -379,3 +379,45 @@ def test_not_started_in_a_daemonic_process_or_when_starting_fails(case, tmp_path
     monkeypatch.setattr(bg, "_start_quietly", refuse)
     with faulty_bodies_in_background(case) as back:
         assert not back.started                    # one process builds everything
+
+
+@pytest.mark.slow
+def test_the_second_process_draws_the_mesh_figures_this_one_then_copies(case, tmp_path,
+                                                                        monkeypatch):
+    """The ``then`` tasks of ``geardyn stiffness`` and ``geardyn run``: the second process,
+    holding the cracked body's mesh, draws the FE mesh figures into the cache; this process
+    then takes them from there without drawing (or meshing), and they are the bytes this
+    process draws itself."""
+    from functools import partial
+
+    import geardyn.stiffness.fe as fe
+    from geardyn.studies.paper_result import PLOT_MESH, FigureStore, fe_mesh_figure_task
+    from geardyn.studies.stiffness_outputs import _fe_mesh_png, fe_mesh_png_task
+
+    monkeypatch.setenv("GEARDYN_CACHE_DIR", str(tmp_path / "ahead"))
+    monkeypatch.setenv(FE_PROCESSES_ENV, "1")
+    tasks = (partial(fe_mesh_png_task, case, True), partial(fe_mesh_figure_task, case, True))
+    with faulty_bodies_in_background(case, then=tasks) as back:
+        assert back.started
+    back.process.join(timeout=300)  # (with then work the block does not wait for it)
+    assert back.process.exitcode == 0
+    real = fe.plot_mesh
+
+    def never(*_a, **_k):
+        raise AssertionError("drawn here")
+
+    monkeypatch.setattr(fe, "plot_mesh", never)
+    with record_lookups() as rec:
+        _fe_mesh_png(tmp_path / "a" / "fe_mesh.png", case, True)
+        store = FigureStore()
+        store.cached_here("fig_fe_mesh", PLOT_MESH, case, cracked=True)
+    assert [(r["kind"], r["hit"]) for r in rec] == [("output", True), ("figure", True)]
+    # the oracle: both drawn here, into another cache
+    monkeypatch.setattr(fe, "plot_mesh", real)
+    monkeypatch.setenv("GEARDYN_CACHE_DIR", str(tmp_path / "here"))
+    _fe_mesh_png(tmp_path / "b" / "fe_mesh.png", case, True)
+    here = FigureStore()
+    here.cached_here("fig_fe_mesh", PLOT_MESH, case, cracked=True)
+    assert (tmp_path / "a" / "fe_mesh.png").read_bytes() == \
+        (tmp_path / "b" / "fe_mesh.png").read_bytes()
+    assert store["fig_fe_mesh"].png == here["fig_fe_mesh"].png
