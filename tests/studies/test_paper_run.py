@@ -131,6 +131,17 @@ def test_results_open_the_obvious_way_and_are_compressed(run_dir):
     np.testing.assert_allclose(
         root["table2"].sel(signal="transmission_error", model="II", statistic2="std").item(),
         s["table2"]["transmission_error"]["II"]["std"], rtol=1e-15)
+    # summary.json's units of the tables (built from the diagnoses' signal units) are
+    # results.nc's unit coordinates (built from the report's own table of signal units)
+    units = s["table_units"]
+    for g in root["signal"].values:
+        for k in root["statistic2"].values:
+            assert units["table2"][g][k] == \
+                root["statistic2_units"].sel(signal=g, statistic2=k).item(), (g, k)
+        assert units["table3"][g] == dict(zip(root["statistic3"].values.tolist(),
+                                              root["statistic3_units"].values.tolist(),
+                                              strict=True))
+    assert units["table2"]["transmission_error"]["std"] == "rad"
     root.close()
     tree = xr.open_datatree(out / "results.nc", engine="h5netcdf")
     assert {"stiffness", "diagnostics"} <= set(tree.children)

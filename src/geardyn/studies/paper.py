@@ -792,6 +792,15 @@ def diagnostics_stage(case: Case, out: Path, result: StudyResult) -> None:
                                          if ("I-static", "cracked") in diags else {})})
     result.summary["table2"] = t2
     result.summary["table3"] = t3
+    # their units, as results.nc's statistic2_units / statistic3_units give them: a mean and an
+    # STD in the signal's unit, the shape statistics and the kurtoses dimensionless, a level in
+    # degrees where its name says so
+    sig_units = {name: cracked["II"].signals[sig].unit for sig, name in SIGNAL_KEYS.items()}
+    result.summary["table_units"] = {
+        "table2": {g: {k: sig_units[g] if k in ("mean", "std") else "1"
+                       for k in next(iter(t2[g].values()), {})} for g in t2},
+        "table3": {g: {k: "deg" if k.endswith("_deg") else "1"
+                       for k in next(iter(t3[g].values()), {})} for g in t3}}
 
     # where the crack shows: the peak of the narrowband envelope, per signal and model
     angles = []
