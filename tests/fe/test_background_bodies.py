@@ -421,3 +421,20 @@ def test_the_second_process_draws_the_mesh_figures_this_one_then_copies(case, tm
     assert (tmp_path / "a" / "fe_mesh.png").read_bytes() == \
         (tmp_path / "b" / "fe_mesh.png").read_bytes()
     assert store["fig_fe_mesh"].png == here["fig_fe_mesh"].png
+
+
+@pytest.mark.parametrize("compiled, order", [(True, ["figure", "kernel"]),
+                                             (False, ["kernel", "figure"])])
+def test_the_kernel_first_only_where_numba_must_compile_it(monkeypatch, compiled, order):
+    """A full run's second process: the mesh figure first where the kernel only loads (the
+    first process asks for the figure as its maps end), the kernel first where it compiles
+    (the first process waits for it at its simulations)."""
+    import geardyn.dynamics.warm as warm
+    import geardyn.studies.paper_result as pr
+
+    calls: list[str] = []
+    monkeypatch.setattr(warm, "kernels_compiled", lambda: compiled)
+    monkeypatch.setattr(warm, "compile_kernels", lambda: calls.append("kernel"))
+    monkeypatch.setattr(pr, "fe_mesh_figure_task", lambda *_a: calls.append("figure"))
+    pr.kernels_and_mesh_figure_task(None, True)
+    assert calls == order

@@ -114,7 +114,7 @@ def _faulty_bodies_in_background(case: Case, result: StudyResult):
     import contextlib
     from functools import partial
 
-    from .paper_result import fe_mesh_figure_task
+    from .paper_result import fe_mesh_figure_task, kernels_and_mesh_figure_task
 
     if case.stiffness.method != "fe":
         return contextlib.nullcontext(None)
@@ -126,13 +126,14 @@ def _faulty_bodies_in_background(case: Case, result: StudyResult):
     cracked = case.crack is not None and case.crack.active
     mesh_figure = (partial(fe_mesh_figure_task, case, cracked),) if cracked else ()
     if not result.quick:
-        # then it compiles the time-step kernel, while this one evaluates the maps and goes on,
-        # or loads it from numba's cache (0.3 s) where it is there already; asking numba's
-        # cache here would import numba (53 MB) into this process before its own bodies'
-        # factorisations, the peak of the run's memory
-        return faulty_bodies_in_background(
-            case, then=(*mesh_figure, ImportedOnCall("geardyn.dynamics.warm", "compile_kernels")),
-            progress=progress)
+        # and compiles the time-step kernel, while this one evaluates the maps and goes on, or
+        # loads it from numba's cache (0.3 s) where it is there already (which of the two
+        # first: kernels_and_mesh_figure_task); asking numba's cache here would import numba
+        # (53 MB) into this process before its own bodies' factorisations, the peak of the
+        # run's memory
+        then = (partial(kernels_and_mesh_figure_task, case, cracked),) if cracked else \
+            (ImportedOnCall("geardyn.dynamics.warm", "compile_kernels"),)
+        return faulty_bodies_in_background(case, then=then, progress=progress)
     from ..dynamics.warm import compile_kernels, kernels_compiled
 
     if not kernels_compiled():
