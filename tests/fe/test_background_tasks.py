@@ -120,15 +120,24 @@ def test_quick_compiles_the_kernel_in_a_second_process_only_when_numba_has_not(m
         paper._faulty_bodies_in_background(case, result)
         assert result.kernel_compiler == (None if compiled or not quick else "a process")
         assert result.background == ([] if compiled or not quick else ["a process"])
-    if compiled:
+    from geardyn.studies.paper_result import fe_mesh_figure_task, kernels_and_mesh_figure_task
+
+    def is_task(t, func) -> bool:  # functools.partial(func, case, cracked)
+        return t.func is func and t.args == (case, True) and not t.keywords
+
+    if compiled:  # then the mesh figure of the cracked body it holds
         quick_calls = calls[:2]
-        assert quick_calls == ["asked", ("bodies", [("progress", None)])]
+        assert quick_calls[0] == "asked" and quick_calls[1][0] == "bodies"
+        assert [k for k, _ in quick_calls[1][1]] == ["progress", "then"]
+        (task,) = dict(quick_calls[1][1])["then"]
+        assert is_task(task, fe_mesh_figure_task)
     else:
         quick_calls = calls[:3]
         assert quick_calls == ["asked", ("tasks", (warm.compile_kernels,)),
                                ("bodies", [("progress", None), ("second_process", False)])]
-    # the full run: the bodies' process, then the kernel (compiled or loaded), not asked here
+    # the full run: the bodies' process, then the kernel (compiled or loaded) and the mesh
+    # figure, in the order that process chooses (kernels_and_mesh_figure_task), not asked here
     ((kind, kwargs),) = calls[len(quick_calls):]
     assert kind == "bodies" and [k for k, _ in kwargs] == ["progress", "then"]
     (task,) = dict(kwargs)["then"]
-    assert (task.__module__, task.__qualname__) == ("geardyn.dynamics.warm", "compile_kernels")
+    assert is_task(task, kernels_and_mesh_figure_task)

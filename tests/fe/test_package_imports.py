@@ -3,6 +3,7 @@ first use only: a run whose FE maps are cached never loads it."""
 
 from __future__ import annotations
 
+import pickle
 import subprocess
 import sys
 import textwrap
@@ -120,5 +121,20 @@ def test_the_first_process_imports_numba_with_the_contact_problems_only(tmp_path
     monkeypatch.setattr(background, "faulty_bodies_in_background", fake)
     case = paper_case().with_overrides({"stiffness.method": "fe"})
     paper._faulty_bodies_in_background(case, StudyResult(out=None))
+    # the paper's cracked case: a task of geardyn.studies.paper_result (light, as its import
+    # in a fresh interpreter checks) that imports the kernel's module when called
+    (then,) = seen["then"]
+    from geardyn.studies.paper_result import kernels_and_mesh_figure_task
+
+    assert then.func is kernels_and_mesh_figure_task and then.args == (case, True)
+    light = subprocess.run([sys.executable, "-c", "import sys, pickle; "
+                            f"pickle.loads({pickle.dumps(then)!r}); "
+                            "print('numba' in sys.modules, 'matplotlib' in sys.modules)"],
+                           capture_output=True, text=True, timeout=300)
+    assert light.stdout.split() == ["False", "False"], light.stdout + light.stderr
+    # without a crack: the kernel alone, named by module and function
+    seen.clear()
+    paper._faulty_bodies_in_background(case.with_overrides({"crack.enabled": False}),
+                                       StudyResult(out=None))
     (then,) = seen["then"]
     assert (then.__module__, then.__qualname__) == ("geardyn.dynamics.warm", "compile_kernels")
