@@ -43,7 +43,15 @@ import numpy as np
 from ..config import Case, case_to_toml, paper_case
 from ..geometry import geometry_summary, static_operating_point
 from ..io import write_json_atomic, write_text_atomic
-from .paper_result import PLOT_MESH, FigureStore, ImportedOnCall, Progress, StudyResult
+from .paper_result import (
+    PLOT_MESH,
+    FigureStore,
+    ImportedOnCall,
+    Progress,
+    StudyResult,
+    fe_mesh_figure_task,
+    kernels_and_mesh_figure_task,
+)
 from .paper_validation import validation_tables
 from .paper_values import (
     CONDITION_METRICS,
@@ -114,8 +122,6 @@ def _faulty_bodies_in_background(case: Case, result: StudyResult):
     import contextlib
     from functools import partial
 
-    from .paper_result import fe_mesh_figure_task, kernels_and_mesh_figure_task
-
     if case.stiffness.method != "fe":
         return contextlib.nullcontext(None)
     from ..stiffness.fe.background import faulty_bodies_in_background, tasks_in_background
@@ -124,7 +130,6 @@ def _faulty_bodies_in_background(case: Case, result: StudyResult):
     # after its bodies the second process draws the mesh figure from the cracked body's mesh
     # it holds (this one would mesh the body again to draw it: about 1.5 s on the paper's pinion)
     cracked = case.crack is not None and case.crack.active
-    mesh_figure = (partial(fe_mesh_figure_task, case, cracked),) if cracked else ()
     if not result.quick:
         # and compiles the time-step kernel, while this one evaluates the maps and goes on, or
         # loads it from numba's cache (0.3 s) where it is there already (which of the two
@@ -149,6 +154,7 @@ def _faulty_bodies_in_background(case: Case, result: StudyResult):
         return faulty_bodies_in_background(case, progress=progress, second_process=False)
     # --quick with the kernel compiled: the second process ends with the bodies and the mesh
     # figure (loading the kernel there would not load it here)
+    mesh_figure = (partial(fe_mesh_figure_task, case, cracked),) if cracked else ()
     return faulty_bodies_in_background(case, then=mesh_figure, progress=progress)
 
 
@@ -214,8 +220,8 @@ def stiffness_stage(case: Case, out: Path, result: StudyResult) -> None:
     result.figures.cached("fig5_load_sharing", draw, Deferred(
         fingerprint("fig5_load_sharing curves", healthy), lambda: load_sharing_curves(healthy)))
     if case.stiffness.method == "fe":
-        # imported only to draw: the FE package takes 0.2 s to import (issue 16)
-        # the mesh the maps were built on (with --quick, the coarser one), drawn by the process
+        # PLOT_MESH imports the FE package (0.2 s, issue 16) only to draw; the mesh the maps
+        # were built on (with --quick, the coarser one), drawn by the process
         # that holds it: the second process that built the cracked body draws it into the
         # cache ahead (fe_mesh_figure_task), else this one, which built it; not the figure
         # process, which would mesh the body again

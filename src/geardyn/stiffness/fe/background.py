@@ -94,10 +94,8 @@ def _release_free_memory() -> None:
 
     if not sys.platform.startswith("linux"):
         return
-    try:
+    with contextlib.suppress(OSError, AttributeError):  # another C library (musl): nothing
         ctypes.CDLL("libc.so.6").malloc_trim(0)
-    except (OSError, AttributeError):  # another C library (musl): nothing to do
-        pass
 
 
 def _run_tasks(tasks: tuple) -> None:
