@@ -120,8 +120,10 @@ class ExecutionSpec(_SweepModel):
     batch_size: int | Literal["auto"] = Field(
         "auto", description="Runs per task (= chunk length along 'run'); 'auto' times one run "
                             "and aims at task_seconds.")
-    task_seconds: float = Field(1.0, gt=0, le=3600, description="Target task duration [s] for "
-                                                                "batch_size = 'auto'.")
+    task_seconds: float = Field(5.0, gt=0, le=3600, description="Target task duration [s] for "
+                                                                "batch_size = 'auto' (a batch's "
+                                                                "chunk writes are 1-3 % of a 5 s "
+                                                                "task).")
 
     @field_validator("batch_size")
     @classmethod
