@@ -107,7 +107,7 @@ def check_case(case, *, cache=None) -> list[str]:
         except GeometryError as exc:
             raise _relabel(exc, field) from None
 
-    crack = case.crack if (case.crack is not None and case.crack.active) else None
+    crack = case.active_crack
     if crack is not None:
         z = pair.pinion.teeth if crack.gear == "pinion" else pair.gear.teeth
         if crack.tooth >= z:

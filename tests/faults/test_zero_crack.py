@@ -20,6 +20,18 @@ SMALL = {"stiffness.method": "pem", "stiffness.centre_distances": 3,
          "stiffness.nodes_per_segment": 12}
 
 
+def test_the_case_names_its_crack_only_where_it_changes_the_stiffness():
+    """``Case.active_crack``: the crack where enabled and deeper than zero, else None (the test
+    that the study, the reports and the map keys ask through it)."""
+    case = geardyn.paper_case(SMALL)
+    assert case.active_crack is case.crack and case.crack.depth > 0
+    for off in ({"crack.depth": 0.0}, {"crack.enabled": False}):
+        other = geardyn.paper_case({**SMALL, **off})
+        assert other.crack is not None and other.active_crack is None
+    assert case.model_copy(update={"crack": None}).active_crack is None
+    assert "active_crack" not in case.model_dump()  # derived, not a field of the case file
+
+
 def test_zero_depth_gives_the_healthy_map_bit_for_bit():
     zero = geardyn.paper_case({**SMALL, "crack.depth": 0.0})
     healthy = geardyn.paper_case({**SMALL, "crack.enabled": False})

@@ -77,7 +77,7 @@ def stiffness(
     case = load_case_from_cli(config, set_)
     method = method or case.stiffness.method
     out = target.path
-    has_crack = case.crack is not None and case.crack.active
+    has_crack = case.active_crack is not None
     has_faults = bool(getattr(case, "faults", None))  # the faults list: a "faulty" map
     if has_faults:
         from ..faults import check_method

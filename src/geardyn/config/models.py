@@ -596,6 +596,12 @@ class Case(_Model):
         return v
 
     # ----------------------------------------------------------------- derived objects
+    @property
+    def active_crack(self) -> CrackConfig | None:
+        """The root crack (``[crack]``) where it changes the stiffness (:attr:`CrackConfig.active`:
+        enabled, depth > 0), else None (no crack, a disabled one or one of zero depth)."""
+        return self.crack if self.crack is not None and self.crack.active else None
+
     def gear_pair(self):
         """The :class:`geardyn.geometry.GearPair` of this case."""
         from ..geometry import Gear, GearPair

@@ -129,7 +129,7 @@ def _faulty_bodies_in_background(case: Case, result: StudyResult):
     progress = result.sub_progress("stiffness (FE bodies)")
     # after its bodies the second process draws the mesh figure from the cracked body's mesh
     # it holds (this one would mesh the body again to draw it: about 1.5 s on the paper's pinion)
-    cracked = case.crack is not None and case.crack.active
+    cracked = case.active_crack is not None
     if not result.quick:
         # and compiles the time-step kernel, while this one evaluates the maps and goes on, or
         # loads it from numba's cache (0.3 s) where it is there already (which of the two
@@ -227,8 +227,8 @@ def stiffness_stage(case: Case, out: Path, result: StudyResult) -> None:
         # process, which would mesh the body again
         result.summary["fe_mesh_refinement"] = float(map_case.stiffness.fe.refinement)
         result.figures.cached_here("fig_fe_mesh", PLOT_MESH, map_case,
-                                   cracked=case.crack is not None and case.crack.active)
-    cracks = case.crack is not None and case.crack.active
+                                   cracked=case.active_crack is not None)
+    cracks = case.active_crack is not None
     dd_op = result.summary.get("static", {}).get("centre_distance_change_mm", 0.0) * 1e-3
     dd_op = dd_op if cracked.covers(dd_op) else 0.0
     numbers = map_numbers(healthy, cracked, cracks, dd_op)
@@ -426,7 +426,7 @@ def _fault_angle(case: Case, result: StudyResult) -> float | None:
     None for a healthy pair or a fault the maps do not show."""
     if "cracked" not in result.maps or not fault_word(case):
         return None
-    crack = case.crack is not None and case.crack.active
+    crack = case.active_crack is not None
     if crack and result.crack_angle_rad is not None:
         return result.crack_angle_rad
     from ..stiffness.plots import fault_dip

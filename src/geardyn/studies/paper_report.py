@@ -847,7 +847,7 @@ def _located_sentence(case: Case, s: dict) -> str:
     word = _fault_word(case)
     if s.get("gear_fault_averaged_out"):
         n = sum(1 for f in (case.faults or ()) if (f.gear or "pinion") == "pinion") + int(
-            case.crack is not None and case.crack.active and case.crack.gear == "pinion")
+            case.active_crack is not None and case.crack.gear == "pinion")
         word = "pinion's faults" if n > 1 else "pinion's fault"
     verb = "show" if word.endswith("faults") else "shows"
     return (f" The {word} {verb} at about {s.get('crack_angle_deg'):.0f} deg of pinion rotation "

@@ -234,7 +234,7 @@ def _difference_text(key: str, value, case: Case) -> str:
     shown = {k: v for k, v, _ in _case_rows(case)}
     if key == "faults":
         text = shown.get(key, "none")
-        if text == "none" and case.crack is not None and case.crack.active:
+        if text == "none" and case.active_crack is not None:
             text = (f"none besides the [crack] section's {_fault_description(case)}")
         return text
     if key in shown:
@@ -258,7 +258,7 @@ def _fault_description(case: Case) -> str:
     """The case's faults in a few words, e.g. "spall on pinion tooth 11"."""
     parts = [f"{f.get('type')} on {f.get('gear') or 'pinion'} tooth {f.get('tooth')}"
              for f in (_get(case, "faults") or []) if isinstance(f, dict)]
-    if case.crack is not None and case.crack.active:
+    if case.active_crack is not None:
         parts.insert(0, f"{case.crack.depth * 1e3:g} mm root crack on {case.crack.gear} tooth "
                         f"{case.crack.tooth}")
     return ", ".join(parts) or "no fault: the same pair as the healthy one"
