@@ -272,6 +272,26 @@ def machine() -> str:
     return f"{name}, {os.cpu_count()} logical cores, Python {platform.python_version()}"
 
 
+#: The host probe's loop, run as a script's top level (its variables module globals), as
+#: ``python3 -c "..."`` runs it: the form the performance log's hand measurements took.
+_PROBE = ("import time\nt0 = time.perf_counter()\ns = 0\nfor i in range(n):\n    s += i\n"
+          "seconds = time.perf_counter() - t0\n")
+
+
+def python_loop(n: int = 10_000_000) -> tuple[float, int]:
+    """The host's speed at interpreter-bound work: seconds for a pure-Python loop of ``n``
+    integer additions at a script's top level, and the sum it made (``n (n - 1) / 2``).
+
+    The virtual machine's host changes between sessions, up to about 2x apart in speed
+    (docs/performance.md: 1e7 additions in about 1 s on 11-27's faster host, 1.95-2.29 s on
+    11-28's); printed with every table (:func:`main` of ``run.py``) so that runs on different
+    hosts are not read as a change of the code.
+    """
+    scope: dict = {"n": int(n)}
+    exec(compile(_PROBE, "<host probe>", "exec"), scope)  # noqa: S102 (our own constant code)
+    return float(scope["seconds"]), int(scope["s"])
+
+
 def load_average() -> float:
     """The 1-minute load average (NaN where the system has none)."""
     import os

@@ -20,7 +20,7 @@ import traceback
 HERE = pathlib.Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
-from _common import Row, load_average, machine  # noqa: E402
+from _common import Row, load_average, machine, python_loop  # noqa: E402
 
 
 def _load(path: pathlib.Path):
@@ -47,8 +47,10 @@ def main(argv: list[str] | None = None) -> int:
     load0 = load_average()
     # the machine, its load and the date with every table (issue 16.8: read the ratios against
     # the same run's baselines; the absolute times depend on both)
+    probe0 = python_loop()[0]
     console.print(f"{started:%Y-%m-%d %H:%M} UTC; {machine()}; 1-min load average "
-                  f"{load0:.2f} at the start", highlight=False)
+                  f"{load0:.2f} at the start; a pure-Python loop of 1e7 additions "
+                  f"{probe0:.2f} s", highlight=False)
     files = sorted(HERE.glob("bench_*.py"))
     if args.only:
         files = [f for f in files if any(s in f.stem for s in args.only)]
@@ -72,7 +74,9 @@ def main(argv: list[str] | None = None) -> int:
                 met = f"{met}, {r.margin}"
             table.add_row(r.name, f"{r.value:.4g} {r.unit}", base, ratio, r.target, met)
     table.caption = (f"{started:%Y-%m-%d %H:%M} UTC; {machine()}; 1-min load average "
-                     f"{load0:.2f} at the start, {load_average():.2f} at the end")
+                     f"{load0:.2f} at the start, {load_average():.2f} at the end; a pure-Python "
+                     f"loop of 1e7 additions {probe0:.2f} s at the start, "
+                     f"{python_loop()[0]:.2f} s at the end")
     console.print(table)
     return 1 if failed else 0
 

@@ -102,3 +102,13 @@ def test_cpu_time_of_a_process_tree_counts_a_child_nobody_waits_for():
     common.run_measured([sys.executable, "-c", code], dict(os.environ), cpu_out=cpu)
     assert len(cpu) == 1
     assert 0.8 - 2 * 0.05 <= cpu[0] <= 0.8 + 2 * 0.5, cpu
+
+
+def test_the_host_probe_runs_its_whole_loop():
+    """The host probe printed with every benchmark table (``_common.python_loop``) adds every
+    integer below n, at a script's top level: the sum is n (n - 1) / 2, and a loop of no
+    additions sums to 0."""
+    seconds, total = common.python_loop(100_000)
+    assert total == 100_000 * 99_999 // 2
+    assert 0.0 < seconds < 60.0
+    assert common.python_loop(0)[1] == 0
