@@ -283,7 +283,7 @@ def python_loop(n: int = 10_000_000) -> tuple[float, int]:
     integer additions at a script's top level, and the sum it made (``n (n - 1) / 2``).
 
     The virtual machine's host changes between sessions, up to about 2x apart in speed
-    (docs/performance.md: 1e7 additions in about 1 s on 11-27's faster host, 1.95-2.29 s on
+    (docs/performance.md: 1e7 additions in about 1 s on 11-27's faster host, 1.7-2.4 s on
     11-28's); printed with every table (:func:`main` of ``run.py``) so that runs on different
     hosts are not read as a change of the code.
     """

@@ -82,12 +82,13 @@ that loads the compiled kernels and the stiffness map) and a task gets
 ``ceil(task_seconds / t_run)`` runs, with the number of tasks rounded up to whole rounds of the
 workers. ``task_seconds`` is 5 s unless set: a batch writes one chunk file per variable (76 for
 the sweep benchmark), 0.05-0.13 s a batch on the machines measured, which is 1-3 % of a 5 s task
-but 5-13 % of a 1 s one (the default until 2026-11-28: one worker ran at 0.85-0.88x of a bare
-loop of the same runs, against 0.93-0.95x with 5 s tasks, ``benchmarks/run.py sweep``), and a
-store of many runs holds a fifth of the files. The price: a worker reports progress, and loses
-work to a kill, in steps of about 5 s. Before the runs, each distinct stiffness map of the
-sweep is built once, in parallel (:meth:`Evaluator.prepare`), so workers never build the same
-map twice at once.
+but 5-13 % of a 1 s one (the default until 2026-11-28). In six comparisons that day, alternating
+or in the same run of ``benchmarks/run.py sweep`` (docs/performance.md), one worker ran at
+0.62-0.95x of a bare loop of the same runs with 5 s tasks and at 0.58-0.89x with 1 s tasks, each
+pair higher with 5 s; and a store of many runs holds a fifth of the files. The price: a worker
+reports progress, and loses work to a kill, in steps of about 5 s. Before the runs, each distinct
+stiffness map of the sweep is built once, in parallel (:meth:`Evaluator.prepare`), so workers
+never build the same map twice at once.
 
 Entry points: :func:`load_sweep`, :meth:`Sweep.plan`, :func:`run_sweep`, :func:`open_sweep`,
 :func:`evaluate_run`.
