@@ -468,13 +468,19 @@ class ToothModifications:
 
     def shares(self, stiffness_map, theta_eff, centre_distance_change, in_contact):
         """Load shares of the slots ``(n, 3)`` from the map (equal shares of the pairs in
-        contact when the map has none)."""
+        contact when the map has none).
+
+        The map's compiled look-up (:meth:`geardyn.stiffness.StiffnessMap.__call__`). Until
+        2026-11-28 this read the map through its pure-NumPy twin
+        (:func:`geardyn.stiffness.map.lookup_reference`, the tests' oracle), about 400 times
+        slower: 11 of the 16 s of a static TE over 23,000 angles
+        (``tests/faults/test_wear_archard.py``). ``tests/modifications/test_static_te.py``
+        compares the two.
+        """
         th = np.asarray(theta_eff, float)
         if "load_share" in getattr(stiffness_map, "extra", {}):
-            from .stiffness.map import lookup_reference
-
-            return np.stack([lookup_reference(th, np.full(th.shape, centre_distance_change),
-                                              stiffness_map.arrays("load_share", slot=k))
+            dd = np.full(th.shape, float(centre_distance_change))
+            return np.stack([np.asarray(stiffness_map(th, dd, "load_share", k), float)
                              for k in range(3)], axis=-1)
         cnt = np.maximum(in_contact.sum(axis=-1, keepdims=True), 1)
         return in_contact / cnt

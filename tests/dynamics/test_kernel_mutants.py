@@ -682,7 +682,12 @@ def _expected_excitation(mods, smap, th, tha, dd, pfree, sep):
     th_k = th - run / mods.pair.pinion.base_radius
     inc = pe["in_contact"][0]
     e = pe["e"][0]
-    sh = mods.shares(smap, np.array([th_k]), dd, pe["in_contact"])[0]
+    if "load_share" in smap.extra:  # the shares by the map's NumPy twin, not its compiled
+        sh = np.array([float(lookup_reference(np.array(th_k), np.array(dd),  # look-up (the
+                                              smap.arrays("load_share", slot=k)))  # kernel's)
+                       for k in range(3)])
+    else:
+        sh = mods.shares(smap, np.array([th_k]), dd, pe["in_contact"])[0]
     k_mb = float(smap(th_k, dd)) if "load_share" in smap.extra else math.nan
     if not inc.any():
         return th_k, run, 1.0, 1.0, k_mb

@@ -178,3 +178,31 @@ def test_quasi_static_simulation_reproduces_the_loaded_static_te():
     assert np.ptp(static) > 5e-6
     assert np.median(err) < 1e-8 and np.percentile(err, 95) < 0.01 * np.ptp(static)
     assert err.max() < 0.03 * np.ptp(static)  # transients at the handovers and contact onsets
+
+
+def test_load_shares_by_the_compiled_lookup_equal_the_numpy_twin():
+    """``ToothModifications.shares`` reads the map's load shares through the compiled look-up:
+    they equal the pure-NumPy twin (``lookup_reference``, written independently) to 1e-12 at
+    angles over two pinion revolutions and three centre distances, and each angle's slots sum
+    to one where a pair is in contact. A map without shares gives equal shares."""
+    from geardyn.stiffness.map import lookup_reference
+
+    smap = pem_healthy_map()
+    mods = ToothModifications.none(smap_pair := case_with().gear_pair())
+    th = np.linspace(-0.3, 4 * math.pi, 1501)
+    for dd in (smap.dd[0], 0.37 * smap.dd[-1], smap.dd[-1]):
+        pe = mods.pair_errors(th, dd)
+        got = mods.shares(smap, pe["theta_eff"], dd, pe["in_contact"])
+        want = np.stack([lookup_reference(pe["theta_eff"], np.full(th.shape, dd),
+                                          smap.arrays("load_share", slot=k))
+                         for k in range(3)], axis=-1)
+        assert got.shape == (th.size, 3)
+        np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-12)
+        in_contact = pe["in_contact"].any(axis=1)
+        np.testing.assert_allclose(got[in_contact].sum(axis=1), 1.0, atol=1e-9)
+    plain = smooth_map(smap_pair)
+    pe = mods.pair_errors(th[:50], 0.0)
+    eq = mods.shares(plain, pe["theta_eff"], 0.0, pe["in_contact"])
+    n = pe["in_contact"].sum(axis=1, keepdims=True)
+    np.testing.assert_array_equal(eq, pe["in_contact"] / np.maximum(n, 1))
+
