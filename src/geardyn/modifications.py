@@ -473,7 +473,7 @@ class ToothModifications:
         The map's compiled look-up (:meth:`geardyn.stiffness.StiffnessMap.__call__`). Until
         2026-11-28 this read the map through its pure-NumPy twin
         (:func:`geardyn.stiffness.map.lookup_reference`, the tests' oracle), about 400 times
-        slower: 11 of the 16 s of a static TE over 23,000 angles
+        slower: 11 of the 16 s (cProfile) of a static TE over 23,000 angles
         (``tests/faults/test_wear_archard.py``). ``tests/modifications/test_static_te.py``
         compares the two.
         """

@@ -682,9 +682,10 @@ def _expected_excitation(mods, smap, th, tha, dd, pfree, sep):
     th_k = th - run / mods.pair.pinion.base_radius
     inc = pe["in_contact"][0]
     e = pe["e"][0]
-    if "load_share" in smap.extra:  # the shares by the map's NumPy twin, not its compiled
-        sh = np.array([float(lookup_reference(np.array(th_k), np.array(dd),  # look-up (the
-                                              smap.arrays("load_share", slot=k)))  # kernel's)
+    # the shares by the map's NumPy twin, not by its compiled look-up (the kernel's)
+    if "load_share" in smap.extra:
+        sh = np.array([float(lookup_reference(np.array(th_k), np.array(dd),
+                                              smap.arrays("load_share", slot=k)))
                        for k in range(3)])
     else:
         sh = mods.shares(smap, np.array([th_k]), dd, pe["in_contact"])[0]
