@@ -30,6 +30,7 @@ Layout of the arrays (``values[i_d, node]``, ``node = (2 c + zone) n_seg + j``)
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 from collections.abc import Callable, Mapping
@@ -67,6 +68,15 @@ class MapArrays(NamedTuple):
     values: np.ndarray  # (n_d, n_cycles * 2 * n_seg) [N/m]
 
 
+@functools.lru_cache(maxsize=8)
+def _unit_fractions(n_seg: int) -> np.ndarray:
+    """``np.linspace(0, 1, n_seg)``, read-only, made once per ``n_seg`` (it cost a quarter of a
+    scalar :func:`lookup_reference`)."""
+    fr = np.linspace(0.0, 1.0, n_seg)
+    fr.setflags(write=False)
+    return fr
+
+
 def lookup_reference(theta: np.ndarray, dd: np.ndarray, arrays: MapArrays) -> np.ndarray:
     """Pure-NumPy twin of :func:`lookup`, written independently (``np.interp`` per zone).
 
@@ -78,22 +88,25 @@ def lookup_reference(theta: np.ndarray, dd: np.ndarray, arrays: MapArrays) -> np
     tm = arrays.mesh_angle
     period = arrays.n_cycles * tm
     grid = arrays.dd0 + arrays.ddd * np.arange(n_d)
-    fr = np.linspace(0.0, 1.0, arrays.n_seg)
+    fr = _unit_fractions(arrays.n_seg)
     for idx in np.ndindex(theta.shape):
-        th, d = theta[idx], dd[idx]
+        # Python floats: the same IEEE arithmetic as NumPy's float64 scalars (``%`` and ``//``
+        # as ``np.mod`` and ``np.floor_divide``), without their per-operation overhead (the
+        # twin kernels call this once per time step)
+        th, d = float(theta[idx]), float(dd[idx])
         if n_d == 1:
             lines, weights = [0], [1.0]
-            a, la = arrays.phase_a[0], arrays.length_a[0]
+            a, la = float(arrays.phase_a[0]), float(arrays.length_a[0])
         else:
             if d < grid[0] - 1e-9 * arrays.ddd or d > grid[-1] + 1e-9 * arrays.ddd:
                 out[idx] = np.nan
                 continue
-            a = np.interp(d, grid, arrays.phase_a)
-            la = np.interp(d, grid, arrays.length_a)
-            i = min(max(np.searchsorted(grid, d, side="right") - 1, 0), n_d - 2)
-            w = min(max((d - grid[i]) / arrays.ddd, 0.0), 1.0)
+            a = float(np.interp(d, grid, arrays.phase_a))
+            la = float(np.interp(d, grid, arrays.length_a))
+            i = min(max(int(np.searchsorted(grid, d, side="right")) - 1, 0), n_d - 2)
+            w = min(max((d - float(grid[i])) / arrays.ddd, 0.0), 1.0)
             lines, weights = [i, i + 1], [1 - w, w]
-        r = np.mod(th - a, period)
+        r = (th - a) % period
         c = min(int(r // tm), arrays.n_cycles - 1)
         r -= c * tm
         if r < la:
