@@ -267,7 +267,9 @@ def _shipped_layer(name: str, chain: tuple[str, ...]) -> _Layers:
     The file is read every time and parsed once per text (:func:`_parsed_shipped_layer`):
     parsing the paper's case was 9 of the 10.6 ms of a :func:`paper_case`, paid by every
     command and many thousands of times by the test suite (measured 2026-11-28); the copy
-    takes 0.3 ms. An edited file (an editable install) is parsed again.
+    takes 0.3 ms. An edited file (an editable install) is parsed again. The key is the
+    file's own text: a shipped case that extended another shipped file would not see that
+    file's edits (none does: ``xue_howard.toml`` is complete).
     """
     label = f"geardyn/cases/{name}.toml"
     text = resources.files("geardyn.cases").joinpath(f"{name}.toml").read_text("utf-8")
