@@ -479,7 +479,7 @@ class ToothModifications:
         """
         th = np.asarray(theta_eff, float)
         if "load_share" in getattr(stiffness_map, "extra", {}):
-            dd = np.full(th.shape, float(centre_distance_change))
+            dd = float(centre_distance_change)  # (the map broadcasts it over theta)
             return np.stack([np.asarray(stiffness_map(th, dd, "load_share", k), float)
                              for k in range(3)], axis=-1)
         cnt = np.maximum(in_contact.sum(axis=-1, keepdims=True), 1)

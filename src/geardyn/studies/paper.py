@@ -219,6 +219,7 @@ def stiffness_stage(case: Case, out: Path, result: StudyResult) -> None:
         fingerprint("fig5_stiffness curves", healthy), lambda: stiffness_curves(healthy)))
     result.figures.cached("fig5_load_sharing", draw, Deferred(
         fingerprint("fig5_load_sharing curves", healthy), lambda: load_sharing_curves(healthy)))
+    cracks = case.active_crack is not None
     if case.stiffness.method == "fe":
         # PLOT_MESH imports the FE package (0.2 s, issue 16) only to draw; the mesh the maps
         # were built on (with --quick, the coarser one), drawn by the process
@@ -226,9 +227,7 @@ def stiffness_stage(case: Case, out: Path, result: StudyResult) -> None:
         # cache ahead (fe_mesh_figure_task), else this one, which built it; not the figure
         # process, which would mesh the body again
         result.summary["fe_mesh_refinement"] = float(map_case.stiffness.fe.refinement)
-        result.figures.cached_here("fig_fe_mesh", PLOT_MESH, map_case,
-                                   cracked=case.active_crack is not None)
-    cracks = case.active_crack is not None
+        result.figures.cached_here("fig_fe_mesh", PLOT_MESH, map_case, cracked=cracks)
     dd_op = result.summary.get("static", {}).get("centre_distance_change_mm", 0.0) * 1e-3
     dd_op = dd_op if cracked.covers(dd_op) else 0.0
     numbers = map_numbers(healthy, cracked, cracks, dd_op)
