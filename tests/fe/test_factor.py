@@ -48,6 +48,65 @@ def test_solve_equals_a_dense_solve(solver, k):
     np.testing.assert_allclose(x, np.linalg.solve(A.toarray(), b), rtol=1e-10, atol=1e-12)
 
 
+@pytest.mark.parametrize("fmt", ["csr", "csc", "coo"])
+@pytest.mark.parametrize("symmetric", [True, False])
+def test_lower_triangle_equals_scipy_tril(fmt, symmetric):
+    """:func:`lower_triangle` against ``scipy.sparse.tril`` (SciPy's own, through COO: an
+    independent implementation), entry for entry, for each input format and for a matrix that
+    is not symmetric (the filter must read rows and columns the right way round), with empty
+    rows and columns; its own lower triangle comes back unchanged."""
+    rng = np.random.default_rng(3)
+    A = sp.random(40, 40, density=0.15, random_state=rng, format="csr")
+    A = A + A.T if symmetric else A
+    A = A.tolil()
+    A[7, :] = 0.0
+    A[:, 7] = 0.0
+    A = A.asformat(fmt)
+    L = F.lower_triangle(A)
+    assert L.format == "csc" and L.shape == A.shape
+    ref = sp.tril(A, format="csc")
+    np.testing.assert_array_equal(L.toarray(), ref.toarray())
+    assert L.nnz == ref.nnz
+    assert F.lower_triangle(L) is L
+
+
+def test_lower_triangle_refuses_what_is_not_a_square_sparse_matrix():
+    with pytest.raises(TypeError, match="scipy.sparse"):
+        F.lower_triangle(np.eye(3))
+    with pytest.raises(ValueError, match="square"):
+        F.lower_triangle(sp.csr_matrix((3, 4)))
+
+
+@needs_cholmod
+def test_cholmod_given_the_lower_triangle_solves_as_given_the_whole_matrix(paper_case):
+    """CHOLMOD reads the lower triangle of what it is given, so handing it only that
+    (geardyn's path since 2026-11-28, for memory) changes nothing: the coarse cracked pinion
+    body's displacements bit for bit equal to cholespy given the whole free-free matrix, as
+    before. The body's matrix is symmetric to round-off only, so this also checks that the
+    triangle taken is the lower one."""
+    import cholespy
+    from skfem import condense
+
+    s = coarse_settings(paper_case)
+    gear = paper_case.gear_pair().pinion
+    mesh = build_body_mesh(gear, s.mesh_settings(), CrackGeometry(depth=2e-3,
+                                                                  angle=np.deg2rad(45)))
+    mat = ElasticMaterial(float(paper_case.material.youngs_modulus),
+                          float(paper_case.material.poisson_ratio))
+    body = ElasticBody(mesh, mat)
+    kff = sp.csc_matrix(condense(body.K, D=body.fixed, expand=False))
+    n = kff.shape[0]
+    whole = cholespy.CholeskySolverD(n, kff.indptr.copy(), kff.indices.copy(), kff.data.copy(),
+                                     cholespy.MatrixType.CSC)
+    b = np.random.default_rng(4).standard_normal((n, 3))
+    x_whole = np.empty_like(b)
+    whole.solve(b.copy(), x_whole)
+    body.factor(solver="cholmod")
+    rhs = np.zeros((body.n_dofs, 3))
+    rhs[body.free] = b
+    np.testing.assert_array_equal(body.solve(rhs)[body.free], x_whole)
+
+
 @needs_cholmod
 def test_influence_coefficients_equal_for_both_solvers(paper_case):
     """The cracked coarse pinion body, loaded on every refined tooth: CHOLMOD and SuperLU give

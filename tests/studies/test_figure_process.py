@@ -553,3 +553,43 @@ def test_what_the_study_hands_over_draws_without_xarray_or_the_case_models(tmp_p
     assert out.returncode == 0, out.stderr
     assert out.stdout.strip() == "", out.stdout
     assert pickle.loads((tmp_path / "pngs.pkl").read_bytes()) == expected
+
+
+_LET_GO_CHILD = """
+import gc, json, pickle, weakref
+import matplotlib
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+from geardyn.studies import figure_process as fp
+
+drawn = []
+
+def draw(n):
+    fig, ax = plt.subplots()
+    ax.plot(range(n))
+    drawn.append(weakref.ref(fig))
+    return fig
+
+gc.disable()  # no automatic collection: only the worker's own can free the figure's cycles
+before = gc.get_freeze_count()
+png = fp._draw_pickled(pickle.dumps((draw, (10,), {})))
+print(json.dumps({"png": png[:8].hex(), "figure_alive": drawn[0]() is not None,
+                  "frozen_before": before, "frozen_after": gc.get_freeze_count()}))
+"""
+
+
+def test_the_worker_lets_each_figure_go():
+    """In the worker (a fresh interpreter here, as the worker is), a figure drawn through
+    ``_draw_pickled`` is a PNG and is gone when the call returns: matplotlib's figure holds
+    reference cycles that only a collection frees (the automatic one is switched off in the
+    child), and what survives the collection is frozen for the next figure's."""
+    import json
+    import subprocess
+    import sys
+
+    out = subprocess.run([sys.executable, "-c", _LET_GO_CHILD], capture_output=True, text=True,
+                         check=True, timeout=120)
+    r = json.loads(out.stdout)
+    assert r["png"] == b"\x89PNG\r\n\x1a\n".hex()
+    assert r["figure_alive"] is False
+    assert r["frozen_before"] == 0 and r["frozen_after"] > 0

@@ -71,7 +71,28 @@ def _draw_pickled(payload: bytes) -> bytes:
     import pickle
 
     draw, args, kwargs = pickle.loads(payload)
-    return draw_png(draw, args, kwargs)
+    try:
+        return draw_png(draw, args, kwargs)
+    finally:
+        _let_go()
+
+
+def _let_go() -> None:
+    """In the worker, after each figure: the figure's objects collected and their pages given
+    back to the operating system (:func:`geardyn.heap.release_free_memory`), so that the worker
+    does not grow with each figure while the study's process draws beside it (at the end of a
+    ``geardyn run --quick`` the worker held 170 MB, 133 MB with this; 2026-11-28). What
+    survives the collection (the imports, matplotlib's caches) is frozen (:func:`gc.freeze`),
+    so the next figure's collection looks only at the objects made since: 15-19 ms a figure
+    against 50-60 ms for a full collection (a 3 x 2 figure, measured 2026-11-28). A frozen
+    object that becomes garbage later is not collected; the worker lives for one study."""
+    import gc
+
+    from ..heap import release_free_memory
+
+    gc.collect()
+    gc.freeze()
+    release_free_memory()
 
 
 def _warm_up() -> None:

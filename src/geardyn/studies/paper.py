@@ -42,6 +42,7 @@ import numpy as np
 
 from ..config import Case, case_to_toml, paper_case
 from ..geometry import geometry_summary, static_operating_point
+from ..heap import release_free_memory
 from ..io import write_json_atomic, write_text_atomic
 from .paper_result import (
     PLOT_MESH,
@@ -1003,6 +1004,10 @@ def run_paper_study(case: Case | None = None, out: str | Path = "geardyn-out", *
             result.emit(name, i, len(STAGES))
             t0 = time.perf_counter()
             stage(case, out, result)
+            # what the stage freed goes back to the operating system, not only to this
+            # process's allocator: 40-75 MB a stage, while the figure process may be drawing
+            # (geardyn.heap)
+            release_free_memory()
             result.seconds[name] = time.perf_counter() - t0
             result.stages.append(name)
             result.summary["stages"] = list(result.stages)

@@ -54,7 +54,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ...errors import InputError, NumericalError
-from .factor import Factorisation, factorise
+from .factor import Factorisation, default_solver, factorise, lower_triangle
 from .mesh import BodyMesh
 
 __all__ = ["ElasticMaterial", "ElasticBody", "flank_points", "influence_matrices",
@@ -278,9 +278,13 @@ class ElasticBody:
 
         if self._lu is None:
             t0 = time.perf_counter()
-            kff = condense(self.K, D=self.fixed, expand=False).tocsc()
+            solver = default_solver() if solver is None else solver
+            kff = condense(self.K, D=self.fixed, expand=False)
             if release_matrix:
                 self.K = None
+            # CHOLMOD reads the lower triangle only: the whole free-free matrix is dropped
+            # before it factorises (the paper's cracked pinion: 20-37 MB less at the peak)
+            kff = lower_triangle(kff) if solver == "cholmod" else kff.tocsc()
             self._lu = factorise(kff, solver)
             del kff
             self.t_factor = time.perf_counter() - t0
