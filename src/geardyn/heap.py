@@ -20,6 +20,8 @@ then does nothing and says so.
 References
 ----------
 malloc_trim(3), Linux man-pages (2020-08-13): https://man7.org/linux/man-pages/man3/malloc_trim.3.html
+CPython 3.11, ``Modules/gcmodule.c``, ``gc_collect_generations``: a full collection is skipped
+while ``long_lived_pending < long_lived_total / 4``.
 """
 
 from __future__ import annotations
@@ -56,8 +58,15 @@ def release_free_memory(*, collect: bool = False) -> bool:
     ----------
     collect : bool
         Run Python's cyclic garbage collector first (objects in reference cycles are freed
-        only by it; about 90 ms in a process with ``geardyn run``'s imports, against about
-        13 ms for the trim of 60 MB, measured 2026-11-28).
+        only by it). Costly and not neutral in a long process: about 90 ms with ``geardyn
+        run``'s imports (the trim of 60 MB about 13 ms), and not neutral: a collection after
+        each FE body raised the later peak of a one-process ``geardyn run`` from 563-567 MB
+        to 590 MB (2026-11-28). Probably because a full collection puts every surviving
+        object in the oldest generation, which CPython collects again only once a quarter as
+        many objects have joined it (``gc_collect_generations`` in CPython's
+        ``Modules/gcmodule.c``), so the cyclic garbage made afterwards lives longer. geardyn
+        collects only in the figure process, whose survivors it then freezes
+        (:mod:`geardyn.studies.figure_process`).
 
     Returns
     -------

@@ -291,10 +291,11 @@ def body_influence(gear: Gear, material: ElasticMaterial, settings: FESettings,
                                  progress=progress, u_by_offset=by)
         # the body's mesh, matrices and factors are freed here: their pages go back to the
         # operating system, not only to this process's allocator (about 60 MB of the paper's
-        # pinion, while another process may be factorising its own body; geardyn.heap). The
-        # collection (about 0.1 s) runs only when a body is built, never on a warm run.
+        # pinion, while another process may be factorising its own body; geardyn.heap).
+        # Without a garbage collection: one here raised the later peak of a one-process
+        # `geardyn run` from 563-567 MB to 590 MB (geardyn.heap.release_free_memory)
         del body
-        release_free_memory(collect=True)
+        release_free_memory()
         stats = {**inf.stats, "t_mesh": t_mesh, "t_total": time.perf_counter() - t0}
         return BodyInfluence(u=inf.u, load_offsets=inf.load_offsets,
                              read_offsets=inf.read_offsets, H=inf.H, half_width=inf.half_width,
