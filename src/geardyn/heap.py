@@ -36,14 +36,17 @@ __all__ = ["release_free_memory"]
 def _malloc_trim():
     """glibc's ``malloc_trim``, or None where the C library has none."""
     import ctypes
-    import ctypes.util
     import sys
 
     if not sys.platform.startswith("linux"):
         return None
+    # the symbols the interpreter is linked with, glibc's among them (dlopen(NULL)); not
+    # ctypes.util.find_library, which runs `ldconfig -p` as a child process: until it execs,
+    # a child forked from a process of 400 MB shows that process's pages as its own, which
+    # is probably how a benchmark's sampler, summing the processes' resident sets, saw a
+    # `geardyn run --quick` at 911 MB (proportional set sizes 549 MB; 2026-11-28)
     try:
-        libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6")
-        fn = libc.malloc_trim
+        fn = ctypes.CDLL(None).malloc_trim
     except (OSError, AttributeError):  # not glibc (musl has no malloc_trim)
         return None
     fn.argtypes = [ctypes.c_size_t]
