@@ -67,11 +67,13 @@ def test_lower_triangle_equals_scipy_tril(fmt, symmetric):
     ref = sp.tril(A, format="csc")
     np.testing.assert_array_equal(L.toarray(), ref.toarray())
     assert L.nnz == ref.nnz
+    # 4-byte indices kept (the point is memory): no int64 copy of the index arrays
+    assert L.indices.dtype == np.int32 and L.indptr.dtype == np.int32
     assert F.lower_triangle(L) is L
 
 
 def test_lower_triangle_refuses_what_is_not_a_square_sparse_matrix():
-    with pytest.raises(TypeError, match="scipy.sparse"):
+    with pytest.raises(TypeError, match="scipy.sparse matrix is needed, not ndarray"):
         F.lower_triangle(np.eye(3))
     with pytest.raises(ValueError, match="square"):
         F.lower_triangle(sp.csr_matrix((3, 4)))

@@ -185,7 +185,7 @@ def lower_triangle(A) -> sp.csc_matrix:
 
     What CHOLMOD reads of a symmetric matrix (``stype = -1``), with half the entries: cholespy
     copies its input into a CHOLMOD matrix before it factorises, so a whole matrix would sit in
-    memory three times (the caller's, CHOLMOD's copy, and a CSC conversion) beside the factors.
+    memory twice (the caller's and CHOLMOD's copy) beside the factors.
     Unlike ``scipy.sparse.tril`` no COO copy of the whole matrix is made: the entries are
     filtered in ``A``'s own compressed format (one row or column index per entry, 4 bytes, and
     a mask), and only the kept half is transposed where ``A`` is CSR. ``A`` itself is returned,
@@ -193,7 +193,7 @@ def lower_triangle(A) -> sp.csc_matrix:
 
     Measured on the paper's cracked pinion body (150,880 DOFs, free-free stiffness 3,313,988
     entries, 1,732,111 in its lower triangle), CHOLMOD in a fresh process, 2026-11-28: peak
-    resident set of the factorisation 321-339 MB against 356-358 MB with the whole matrix;
+    resident set of the factorisation 324-340 MB against 356-358 MB with the whole matrix;
     the displacements bit for bit the same (``tests/fe/test_factor.py``).
 
     Parameters

@@ -283,7 +283,7 @@ class ElasticBody:
             if release_matrix:
                 self.K = None
             # CHOLMOD reads the lower triangle only: the whole free-free matrix is dropped
-            # before it factorises (the paper's cracked pinion: 20-37 MB less at the peak)
+            # before it factorises (the paper's cracked pinion: 16-34 MB less at the peak)
             kff = lower_triangle(kff) if solver == "cholmod" else kff.tocsc()
             self._lu = factorise(kff, solver)
             del kff
