@@ -61,10 +61,10 @@ def release_free_memory(*, collect: bool = False) -> bool:
     ----------
     collect : bool
         Run Python's cyclic garbage collector first (objects in reference cycles are freed
-        only by it). Costly and not neutral in a long process: about 90 ms with ``geardyn
-        run``'s imports (the trim of 60 MB about 13 ms), and not neutral: a collection after
-        each FE body raised the later peak of a one-process ``geardyn run`` from 563-567 MB
-        to 590 MB (2026-11-28). Probably because a full collection puts every surviving
+        only by it). Costly in a long process, about 90 ms with ``geardyn run``'s imports
+        (the trim of 60 MB about 13 ms), and not neutral: a collection after each FE body
+        raised the later peak of a one-process ``geardyn run`` from 563-567 MB to 590 MB
+        (2026-11-28). Probably because a full collection puts every surviving
         object in the oldest generation, which CPython collects again only once a quarter as
         many objects have joined it (``gc_collect_generations`` in CPython's
         ``Modules/gcmodule.c``), so the cyclic garbage made afterwards lives longer. geardyn
