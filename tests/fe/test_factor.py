@@ -34,6 +34,18 @@ def _spd(n: int, seed: int = 0) -> sp.csc_matrix:
     return (lap + r @ r.T).tocsc()
 
 
+def _coarse_cracked_pinion(paper_case):
+    """The paper's pinion with a 2 mm crack at 45 degrees, on the coarse test mesh: the FE
+    settings, the gear, its body mesh and its material."""
+    s = coarse_settings(paper_case)
+    gear = paper_case.gear_pair().pinion
+    mesh = build_body_mesh(gear, s.mesh_settings(), CrackGeometry(depth=2e-3,
+                                                                  angle=np.deg2rad(45)))
+    mat = ElasticMaterial(float(paper_case.material.youngs_modulus),
+                          float(paper_case.material.poisson_ratio))
+    return s, gear, mesh, mat
+
+
 @pytest.mark.parametrize("solver", F.available_solvers())
 @pytest.mark.parametrize("k", [None, 1, 3, 9, 70])
 def test_solve_equals_a_dense_solve(solver, k):
@@ -89,12 +101,7 @@ def test_cholmod_given_the_lower_triangle_solves_as_given_the_whole_matrix(paper
     import cholespy
     from skfem import condense
 
-    s = coarse_settings(paper_case)
-    gear = paper_case.gear_pair().pinion
-    mesh = build_body_mesh(gear, s.mesh_settings(), CrackGeometry(depth=2e-3,
-                                                                  angle=np.deg2rad(45)))
-    mat = ElasticMaterial(float(paper_case.material.youngs_modulus),
-                          float(paper_case.material.poisson_ratio))
+    s, gear, mesh, mat = _coarse_cracked_pinion(paper_case)
     body = ElasticBody(mesh, mat)
     kff = sp.csc_matrix(condense(body.K, D=body.fixed, expand=False))
     n = kff.shape[0]
@@ -114,12 +121,7 @@ def test_influence_coefficients_equal_for_both_solvers(paper_case):
     """The cracked coarse pinion body, loaded on every refined tooth: CHOLMOD and SuperLU give
     the same influence coefficients to 1e-9 relative (the issue's tolerance for solver paths),
     measured against the largest coefficient."""
-    s = coarse_settings(paper_case)
-    gear = paper_case.gear_pair().pinion
-    mesh = build_body_mesh(gear, s.mesh_settings(), CrackGeometry(depth=2e-3,
-                                                                  angle=np.deg2rad(45)))
-    mat = ElasticMaterial(float(paper_case.material.youngs_modulus),
-                          float(paper_case.material.poisson_ratio))
+    s, gear, mesh, mat = _coarse_cracked_pinion(paper_case)
     u = load_roll_lengths(gear, s.n_points)
     H = {}
     for solver in ("cholmod", "superlu"):
