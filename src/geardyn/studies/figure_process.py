@@ -90,9 +90,8 @@ def _let_go() -> None:
 
     from ..heap import release_free_memory
 
-    gc.collect()
+    release_free_memory(collect=True)
     gc.freeze()
-    release_free_memory()
 
 
 def _warm_up() -> None:
