@@ -159,6 +159,19 @@ def _faulty_bodies_in_background(case: Case, result: StudyResult):
     return faulty_bodies_in_background(case, then=mesh_figure, progress=progress)
 
 
+def _note_bodies_process(result: StudyResult, bodies) -> None:
+    """Record the FE bodies' second process (``bodies``, a
+    :class:`~geardyn.stiffness.fe.background.BackgroundBodies`, or None) among the study's
+    background processes; in a full run it also compiles or loads the time-step kernel after
+    the bodies (:func:`_faulty_bodies_in_background`), so the simulation stage waits for it
+    there (:func:`_wait_for_the_kernel`)."""
+    if not bodies:
+        return
+    result.background.append(bodies.process)
+    if not result.quick:
+        result.kernel_compiler = bodies.process
+
+
 def _figure_process(result: StudyResult):
     """A :class:`~.figure_process.FigureProcess` for the study's figures where a second
     process is allowed (:func:`~.figure_process.figure_process_allowed`), started once the
@@ -195,8 +208,7 @@ def stiffness_stage(case: Case, out: Path, result: StudyResult) -> None:
     with warnings.catch_warnings(), _faulty_bodies_in_background(map_case, result) as bodies:
         # (a second process builds the cracked map's FE bodies meanwhile, where cores and
         # memory allow: geardyn.stiffness.fe.background)
-        if bodies:
-            result.background.append(bodies.process)
+        _note_bodies_process(result, bodies)
         if result.background:  # the figure process starts as soon as they have ended (its
             result.figures.start_early()  # imports then overlap this one's work)
         warnings.simplefilter("ignore")  # the maps record their warnings in attrs (read below)
@@ -503,9 +515,44 @@ def _variables(ds, names: tuple[str, ...]) -> dict:
     return {name: ds[name].values for name in ("time", *names)}
 
 
-#: Longest wait [s] for a second process compiling the time-step kernel (it takes 5-10 s on a
+#: Longest wait [s] for a second process compiling the time-step kernel (it takes 5-15 s on a
 #: 2-core machine); after it, this process compiles the kernel itself.
 KERNEL_COMPILE_WAIT_S = 60.0
+
+
+def _wait_for_the_kernel(result: StudyResult) -> float:
+    """Wait for ``result.kernel_compiler`` to put the time-step kernel into numba's cache,
+    rather than compile it here too, drawing held figures meanwhile; at most
+    :data:`KERNEL_COMPILE_WAIT_S`. No wait where numba's cache holds the kernel already or the
+    process has ended (whatever it did: this process then loads or compiles the kernel itself).
+
+    Both processes compiled it at once in a first ``geardyn run`` until 2026-11-28: the FE
+    bodies' process compiles it after the cracked body, and this one reached its simulations
+    first (``py-spy`` of a cold run: 7.6 s of compilation here, the kernel's 13.6 s there,
+    and this process had drawn none of its held figures).
+
+    Returns
+    -------
+    float
+        The time waited [s].
+    """
+    import time
+
+    proc = result.kernel_compiler
+    if proc is None:
+        return 0.0
+    from ..dynamics.warm import kernels_compiled
+
+    t0 = time.monotonic()
+    deadline = t0 + KERNEL_COMPILE_WAIT_S
+
+    def waiting() -> bool:
+        return proc.is_alive() and time.monotonic() < deadline and not kernels_compiled()
+
+    result.figures.draw_held_while(waiting)
+    while waiting():
+        proc.join(timeout=0.1)
+    return time.monotonic() - t0
 
 
 def simulation_stage(case: Case, out: Path, result: StudyResult) -> None:
@@ -519,8 +566,7 @@ def simulation_stage(case: Case, out: Path, result: StudyResult) -> None:
     from . import paper_figures as pf
 
     sim_case = _simulation_case(case, result.quick)
-    if result.kernel_compiler is not None:  # compiling the kernel (stiffness stage): wait for it
-        result.kernel_compiler.join(timeout=KERNEL_COMPILE_WAIT_S)  # rather than compile it too
+    _wait_for_the_kernel(result)
     runs = {}  # held for this stage's figures and numbers; the later stages read `records`
     records = CachedRecords()
     jobs = [("I", "cracked"), ("I-static", "cracked"), ("II", "cracked"), ("I", "healthy"),

@@ -74,8 +74,10 @@ class StudyResult:
     files : dict of str -> Path
         Files written, by role.
     kernel_compiler : multiprocessing.Process, optional
-        A second process compiling the time-step kernel (``--quick`` on a first run after an
-        install), which the simulation stage waits for.
+        A second process that compiles the time-step kernel (``--quick`` on a first run after
+        an install) or compiles or loads it after other work (the FE bodies' process of a
+        full run): where numba's cache does not hold the kernel yet, the simulation stage
+        waits for it, drawing held figures meanwhile, rather than compile it too.
     background : list of multiprocessing.Process
         The study's other second processes (FE bodies, kernel compiler): the figure process
         (:mod:`.figure_process`) starts when they have all ended.
@@ -493,6 +495,28 @@ class FigureStore(dict):
             if isinstance(job, _Pending):
                 self._collect(key, job)
         self.close()
+
+    def draw_held_while(self, keep_going: Callable[[], bool]) -> int:
+        """Draw held figures here (those not sent to the figure process yet), the last first,
+        one at a time while ``keep_going()`` says so: for a process that would otherwise wait
+        (the study waiting for the kernel that a second process compiles, during which the
+        figure process has not started). A figure drawn here goes into the figure cache as
+        :meth:`finish` would put it.
+
+        Returns
+        -------
+        int
+            How many figures were drawn.
+        """
+        drawn = 0
+        while keep_going():
+            with self._lock:
+                job = self._held.pop() if self._held else None
+            if job is None:
+                break
+            self._collect(job.key, job)
+            drawn += 1
+        return drawn
 
     def close(self) -> None:
         """Stop the figure process (queued figures dropped); later figures are drawn here."""

@@ -73,29 +73,18 @@ def _build_faulty_bodies(case, then: tuple = (), cache_root: str | None = None) 
         cache = None if cache_root is None else Cache(cache_root, enabled=True)
         FEStiffness(case, cracked=True, faulty_first=True, cache=cache)
         if then:
-            _release_free_memory()
+            # the bodies' factorisations leave freed pages in this process's heap: 258 MB
+            # resident after the paper's bodies, which drawing the mesh figure then grew to
+            # 362 MB while the first process evaluated the maps (385 MB), a new peak of the run
+            # (760 MB at 16 s against 735 MB at 10 s with both factorising; RSS of every process
+            # every 0.1 s, 2026-11-28); given back to the operating system first
+            from ...heap import release_free_memory
+
+            release_free_memory()
         for task in then:
             task()
     except Exception:  # noqa: BLE001 - reported by the first process, which meets it too
         sys.exit(1)
-
-
-def _release_free_memory() -> None:
-    """Return the heap's free pages to the system (glibc's ``malloc_trim(0)``; nothing where
-    there is no glibc), before the second process goes on to its ``then`` tasks.
-
-    The bodies' factorisations leave their freed pages in the process's heap: 258 MB resident
-    after the paper's bodies, which drawing the mesh figure then grew to 362 MB while the first
-    process evaluated the maps (385 MB), a new peak of the run (760 MB at 16 s against 735 MB
-    at 10 s with both processes factorising; RSS of every process every 0.1 s, 2026-11-28).
-    """
-    import ctypes
-    import sys
-
-    if not sys.platform.startswith("linux"):
-        return
-    with contextlib.suppress(OSError, AttributeError):  # another C library (musl): nothing
-        ctypes.CDLL("libc.so.6").malloc_trim(0)
 
 
 def _run_tasks(tasks: tuple) -> None:
