@@ -240,6 +240,24 @@ def test_static_te_flags_are_booleans(case, kmap, flag, value):
              flag)
 
 
+def test_static_te_refuses_a_misspelt_argument_by_its_own_name_before_any_map(case,
+                                                                              monkeypatch):
+    """A misspelt keyword (or a bad centre-distance change) is refused before a map is built,
+    and the error names ``static_te_of_case``, not the function it hands over to (which it
+    named, after building the map, until 2026-11-28)."""
+    import geardyn.stiffness
+
+    def no_map(*args, **kwargs):
+        raise AssertionError("a map was built")
+
+    monkeypatch.setattr(geardyn.stiffness, "build_map", no_map)
+    with pytest.raises(TypeError, match=r"static_te_of_case\(\) got an unexpected keyword "
+                                        r"argument 'centre_distance'"):
+        static_te_of_case(case, 1.0, centre_distance="0.5 mm")
+    _refused(lambda: static_te_of_case(case, 1.0, centre_distance_change="0.5 N"),
+             "centre_distance_change")
+
+
 def test_static_te_refuses_what_is_not_a_case(kmap):
     _refused(lambda: static_te_of_case("case", 1.0, stiffness_map=kmap), "case")
 

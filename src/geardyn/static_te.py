@@ -183,15 +183,19 @@ def static_transmission_error(stiffness_map, torque: float, *,
 
 
 def static_te_of_case(case, torque: float | None = None, *, cracked: bool = False,
-                      errors: bool = True, stiffness_map=None, **kw):
+                      errors: bool = True, stiffness_map=None, theta=None,
+                      centre_distance_change: float = 0.0, n: int = 2048):
     """:func:`static_transmission_error` of a case: its map (healthy by default, unlike
     :func:`geardyn.stiffness.build_map` and :func:`geardyn.simulate`, whose ``cracked``
     defaults to True), its ``[modifications]`` (``errors=False``: perfect involutes) and
-    ``torque`` (default: the motor torque) [N m]. ``cracked`` and ``errors`` are booleans.
+    ``torque`` (default: the motor torque) [N m]. ``cracked`` and ``errors`` are booleans;
+    ``theta``, ``centre_distance_change`` and ``n`` as for :func:`static_transmission_error`
+    (named here, so that a misspelt argument is refused before a map is built, by this
+    function's name).
 
-    ``torque`` (and ``centre_distance_change`` among ``kw``) may be a number in SI units or a
-    string with a unit as in a case file (``"100 N m"``, ``"0.5 mm"``), like the case's own
-    values; anything else raises :class:`geardyn.errors.InputError` naming the argument.
+    ``torque`` and ``centre_distance_change`` may be a number in SI units or a string with a
+    unit as in a case file (``"100 N m"``, ``"0.5 mm"``), like the case's own values; anything
+    else raises :class:`geardyn.errors.InputError` naming the argument.
     """
     _check_case(case)
     from .errors import check_flag
@@ -200,6 +204,8 @@ def static_te_of_case(case, torque: float | None = None, *, cracked: bool = Fals
     errors = check_flag(errors, "errors")  # "no" was taken as True (a user audit)
     if torque is not None:  # refused by name before a map is built
         torque = _quantity(torque, "torque", "torque")
+    centre_distance_change = _quantity(centre_distance_change, "length",
+                                       "centre_distance_change")
     if stiffness_map is None:
         from .stiffness import build_map
 
@@ -207,7 +213,8 @@ def static_te_of_case(case, torque: float | None = None, *, cracked: bool = Fals
     mods = ToothModifications.from_case(case) if errors else \
         ToothModifications.none(case.gear_pair())
     t = case.motor.torque if torque is None else torque
-    return static_transmission_error(stiffness_map, t, modifications=mods, **kw)
+    return static_transmission_error(stiffness_map, t, modifications=mods, theta=theta,
+                                     centre_distance_change=centre_distance_change, n=n)
 
 
 def static_te_curves(case, torque: float | None = None, *, cracked: bool = False,
