@@ -88,3 +88,27 @@ def test_run_writes_the_geometry_stage(tmp_path):
     assert s["contact_ratio"]["paper_eq8"] == pytest.approx(1.4286, abs=1e-4)
     assert (out / "geometry.json").exists() and (out / "case.toml").exists()
     assert not list(out.glob(".*tmp*"))  # no temporary files left behind
+
+
+@pytest.mark.parametrize("words, cword, expected", [
+    ("geardyn ru", 1, ["run"]),
+    ("geardyn run --qu", 2, ["--quick"]),
+    ("geardyn cache c", 2, ["clear"]),
+])
+def test_tab_completion_answers_commands_and_options(words, cword, expected):
+    """The shell's Tab asks the console script through click's completion protocol (the script
+    ``geardyn --install-completion`` installs, which ``--show-completion`` prints)."""
+    import os
+    import subprocess
+    from pathlib import Path
+
+    exe = Path(sys.executable).with_name("geardyn")
+    env = dict(os.environ, _GEARDYN_COMPLETE="complete_bash", COMP_WORDS=words,
+               COMP_CWORD=str(cword))
+    r = subprocess.run([str(exe)], env=env, capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.split() == expected
+    script = subprocess.run([str(exe), "--show-completion", "bash"], capture_output=True,
+                            text=True, timeout=120)
+    assert script.returncode == 0, script.stderr
+    assert "_GEARDYN_COMPLETE=complete_bash" in script.stdout

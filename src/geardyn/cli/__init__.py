@@ -17,7 +17,7 @@ app = typer.Typer(
     help="Dynamics and vibration diagnostics of flexibly supported spur gears "
          "(Xue & Howard model I / II).",
     no_args_is_help=True,
-    add_completion=False,
+    add_completion=True,
     pretty_exceptions_enable=False,
     rich_markup_mode="rich",
     context_settings={"help_option_names": ["-h", "--help"]},
