@@ -27,17 +27,20 @@ from _common import Row, run_measured
 
 _PEAK_MB: dict[str, float] = {}
 _PEAK_PSS_MB: dict[str, float] = {}
+_CPU_S: dict[str, float] = {}
 
 
 def _run(args: list[str], env: dict) -> float:
     """Wall time [s] of ``geardyn run args``; its peak memory summed over its processes [MB]
     into ``_PEAK_MB`` (resident sets) and ``_PEAK_PSS_MB`` (proportional set sizes: shared
     pages once), sampled from ``/proc`` (the FE bodies and the figures may use second
-    processes)."""
+    processes), and its CPU time [s], summed over its processes, into ``_CPU_S``."""
+    cpu: list[float] = []
     wall, peak, _largest, pss = run_measured([sys.executable, "-m", "geardyn", "run", *args],
-                                             env)
+                                             env, cpu_out=cpu)
     _PEAK_MB[" ".join(args)] = peak
     _PEAK_PSS_MB[" ".join(args)] = pss
+    _CPU_S[" ".join(args)] = cpu[0] if cpu else float("nan")
     return wall
 
 
@@ -95,6 +98,11 @@ def run(quick: bool) -> list[Row]:
         Row(f"  the same as proportional set sizes{label}", pss["cold"], "MB",
             target="< 600 MB", met=pss["cold"] < 600),
         Row(f"geardyn run, cold{label}", t_cold, "s", target="< 40 s", met=t_cold < 40),
+        # the CPU a first run spends compiling numba's kernels, in whichever process (until
+        # 2026-11-28 the study compiled the time-step kernel a second time, beside the FE
+        # bodies' process that compiles it)
+        Row(f"  its CPU time, summed over its processes{label}", _CPU_S[" ".join(cold_args)],
+            "s", "the same run numba compiled (the next row)", _CPU_S[" ".join(two_args)]),
         Row(f"geardyn run, cold geardyn cache, numba compiled, FE bodies by the default{label}",
             t_two, "s", "same in one process (GEARDYN_FE_PROCESSES=0)", t_one, "< 40 s",
             t_two < 40),
