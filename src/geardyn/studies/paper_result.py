@@ -484,12 +484,7 @@ class FigureStore(dict):
         with self._lock:
             self._limit = IN_FLIGHT_AT_FINISH
         self._pump()
-        while True:
-            with self._lock:
-                job = self._held.pop() if self._held else None
-            if job is None:
-                break
-            self._collect(job.key, job)
+        self.draw_held_while(lambda: True)
         for key in pending:
             job = super().__getitem__(key)
             if isinstance(job, _Pending):
