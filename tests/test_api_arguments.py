@@ -240,6 +240,44 @@ def test_static_te_flags_are_booleans(case, kmap, flag, value):
              flag)
 
 
+#: a cheap PEM case with the pinion's manufacturing errors (so that ``errors`` matters)
+ERRORS_CASE = {"stiffness.method": "pem", "stiffness.centre_distances": 3,
+               "stiffness.nodes_per_segment": 6, "modifications.pinion.grade": 6,
+               "modifications.pinion.seed": 1, "modifications.pinion.tip_relief": "10 um",
+               "modifications.pinion.runout": "8 um"}
+
+
+def test_static_te_of_case_is_its_parts_with_the_documented_defaults():
+    """``static_te_of_case(case)`` is :func:`static_transmission_error` of the healthy map
+    at the motor torque with the case's modifications over 2048 angles (its documented
+    defaults), and hands every argument on: computed here from those parts, bit for bit."""
+    from geardyn.modifications import ToothModifications
+    from geardyn.static_te import static_transmission_error
+
+    case = geardyn.paper_case().with_overrides(ERRORS_CASE)
+    healthy = build_map(case, cracked=False)
+    mods = ToothModifications.from_case(case)
+    ref = static_transmission_error(healthy, case.motor.torque, modifications=mods)
+    got = static_te_of_case(case)
+    assert got["transmission_error"].size == 2048
+    np.testing.assert_array_equal(got["transmission_error"], ref["transmission_error"])
+    assert got.attrs["torque"] == case.motor.torque
+    # the defaults are seen: perfect involutes, or the cracked map, give another TE
+    for other in (static_te_of_case(case, errors=False, stiffness_map=healthy),
+                  static_te_of_case(case, cracked=True)):
+        assert not np.allclose(other["transmission_error"], ref["transmission_error"])
+    theta = np.linspace(0.0, 0.3, 7)
+    got = static_te_of_case(case, "50 N m", stiffness_map=healthy, theta=theta,
+                            centre_distance_change="0.2 mm")
+    ref = static_transmission_error(healthy, 50.0, modifications=mods, theta=theta,
+                                    centre_distance_change=0.2e-3)
+    np.testing.assert_array_equal(got["theta"], theta)
+    np.testing.assert_array_equal(got["transmission_error"], ref["transmission_error"])
+    plain = static_transmission_error(healthy, 50.0, modifications=mods, theta=theta)
+    assert not np.allclose(got["transmission_error"], plain["transmission_error"])
+    assert static_te_of_case(case, stiffness_map=healthy, n=16)["transmission_error"].size == 16
+
+
 def test_static_te_refuses_a_misspelt_argument_by_its_own_name_before_any_map(case,
                                                                               monkeypatch):
     """A misspelt keyword (or a bad centre-distance change) is refused before a map is built,
