@@ -117,6 +117,16 @@ def test_operating_refusals_in_words():
     assert op.base_pitch == pair.base_pitch
     with pytest.raises(GeometryError):
         pair.operating(math.nan)
+    # texts made only on an error (a function handed to the check): still made, and in full
+    with pytest.raises(InputError) as exc:
+        pair.operating("1 mm")
+    assert (exc.value.field, exc.value.value, exc.value.allowed) == (
+        "centre_distance_change", "1 mm",
+        f"a number > {rsum - pair.design_centre_distance:.6g} [m] (SI: 0.001 for 1 mm)")
+    with pytest.raises(InputError) as exc:
+        pair.contact_points(math.inf)
+    assert (exc.value.field, exc.value.allowed) == (
+        "theta", "a finite pinion angle of magnitude <= 1e+12 [rad]")
 
 
 def test_involute_inverse_refuses_negative_values_and_converges_from_any_start():

@@ -156,20 +156,26 @@ def test_more_pulses_per_rev_and_time_argument():
 # ------------------------------------------------------------------------------------------
 # kernels: numba twin == NumPy twin; exact on cubic polynomials
 # ------------------------------------------------------------------------------------------
-def test_numba_kernel_matches_numpy_twin():
-    kernel = _numba_kernel()
+@pytest.mark.parametrize("taps", [4, 6, 8])
+def test_numba_kernel_matches_numpy_twin(taps):
+    kernel = _numba_kernel(taps)
     if kernel is None:  # pragma: no cover
         pytest.skip("numba not installed")
     rng = np.random.default_rng(3)
     n = 5000
     angle = np.cumsum(rng.uniform(0.5, 1.5, n)) * 0.01 + 0.3
     x = rng.standard_normal((2, n))
-    for acc, size in ((True, 97), (False, 3000)):
-        a = np.zeros((2, size if acc else 3000))
-        b = np.zeros_like(a)
-        kernel(angle, x, 0.31, 0.0123, 3000, 97, acc, a, 6)
-        _resample_numpy(angle, x, 0.31, 0.0123, 3000, 97, acc, b, chunk=700)
-        np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-12)
+    # output steps around the mean sample spacing (0.01): stencils kept over several output
+    # points and stencils skipped, as at the anti-aliased and the plain TSA's densities
+    for dtheta in (0.0123, 0.0041):
+        for acc, size in ((True, 97), (False, 3000)):
+            a = np.zeros((2, size))
+            b = np.zeros_like(a)
+            kernel(angle, x, 0.31, dtheta, 3000, 97, acc, a)
+            _resample_numpy(angle, x, 0.31, dtheta, 3000, 97, acc, b, chunk=700, taps=taps)
+            np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-12)
+    assert _numba_kernel(taps) is kernel  # compiled once per process and stencil size
+    assert _numba_kernel(4 if taps != 4 else 6) is not kernel
 
 
 @pytest.mark.parametrize("engine", ["numba", "numpy"])
