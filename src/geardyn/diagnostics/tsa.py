@@ -254,7 +254,7 @@ def _resample_numpy(angle: np.ndarray, x: np.ndarray, theta0: float, dtheta: flo
             out[:, j] = v
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _numba_kernel(taps: int = 6):
     """Compile (once per process and stencil size) the numba twin of :func:`_resample_numpy`
     for ``taps``-point stencils; None if numba is absent.
