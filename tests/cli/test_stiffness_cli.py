@@ -132,3 +132,44 @@ def test_a_second_write_copies_every_file_and_draws_nothing(tmp_path, monkeypatc
                        shallow=False)
     assert not filecmp.cmp(tmp_path / "a" / "stiffness_cracked.nc",
                            tmp_path / "c" / "stiffness_cracked.nc", shallow=False)
+
+
+def test_healthy_figures_drawn_ahead_are_the_ones_written_later(tmp_path, monkeypatch):
+    """``healthy_figures_ahead`` (drawn while the FE bodies' second process still builds the
+    faulty body) puts Fig. 5's two figures into the output cache under the keys that
+    :func:`write_stiffness_outputs` looks up: the later write copies them, draws neither again,
+    and its bytes are a plain write's; the run's record counts each entry once, as computed.
+    Without the cache nothing is drawn ahead."""
+    import filecmp
+
+    import geardyn.stiffness.plots as plots
+    from geardyn import paper_case
+    from geardyn.cache import record_lookups
+    from geardyn.cli._outputs import cache_summary
+    from geardyn.stiffness import build_map
+    from geardyn.studies.stiffness_outputs import healthy_figures_ahead, write_stiffness_outputs
+
+    case = paper_case(["stiffness.method=pem", "stiffness.centre_distances=3",
+                       "stiffness.nodes_per_segment=8"])
+    maps = {"healthy": build_map(case, method="pem", cracked=False)}
+    drawn = []
+    real = {name: getattr(plots, name) for name in ("fig_stiffness", "fig_load_sharing")}
+    for name, fn in real.items():
+        monkeypatch.setattr(plots, name, lambda m, _n=name, _f=fn: (drawn.append(_n), _f(m))[1])
+    monkeypatch.setenv("GEARDYN_CACHE_DIR", str(tmp_path / "cache"))
+    with record_lookups() as lookups:
+        healthy_figures_ahead(maps["healthy"])
+        assert sorted(drawn) == ["fig_load_sharing", "fig_stiffness"]
+        assert list((tmp_path / "cache" / "output").glob("*.png"))  # in the cache only
+        written = write_stiffness_outputs(tmp_path / "a", case, maps, "pem", False)
+    assert written == ["stiffness_healthy.nc", "fig5_stiffness.png", "fig5_load_sharing.png"]
+    assert len(drawn) == 2  # copied, not drawn again
+    assert cache_summary(lookups)["output"] == {"hits": 0, "built": 3}
+    monkeypatch.setenv("GEARDYN_CACHE_DIR", str(tmp_path / "plain"))
+    write_stiffness_outputs(tmp_path / "b", case, maps, "pem", False)
+    for name in ("fig5_stiffness.png", "fig5_load_sharing.png"):
+        assert filecmp.cmp(tmp_path / "a" / name, tmp_path / "b" / name, shallow=False), name
+    drawn.clear()
+    monkeypatch.setenv("GEARDYN_NO_CACHE", "1")
+    healthy_figures_ahead(maps["healthy"])
+    assert drawn == []

@@ -47,7 +47,10 @@ def test_building_the_faulty_bodies_imports_neither_numba_nor_matplotlib(tmp_pat
     cracked pinion, checked and meshed, then the healthy bodies, on a coarse mesh) leaves numba
     and matplotlib unimported: their 53 MB and 13 MB (2026-11-27) would sit beside the
     factorisations, the peak of a run's memory. numba comes later, with the contact problems
-    (``solve_batch``) or the kernel's compilation; a crack's inside test is NumPy's."""
+    (``solve_batch``) or the kernel's compilation; a crack's inside test is NumPy's. Since
+    2026-11-28 it builds the bodies only (:meth:`FEStiffness.bodies_into_cache`), not the
+    contact model: scipy.interpolate stays unimported too, and the bodies are the ones
+    ``FEStiffness`` then loads from the cache."""
     code = textwrap.dedent("""
         import sys
         import geardyn
@@ -55,16 +58,34 @@ def test_building_the_faulty_bodies_imports_neither_numba_nor_matplotlib(tmp_pat
         from geardyn.stiffness.fe.model import FEStiffness
         case = geardyn.paper_case().with_overrides({
             "stiffness.method": "fe", "stiffness.fe.refinement": 0.25})
-        fe = FEStiffness(case, cracked=True, faulty_first=True,
-                         cache=Cache(sys.argv[1], enabled=True))
-        print(len(fe.influence), sorted({"cracked", "pinion", "gear"} & set(fe.influence)),
-              [m for m in ("numba", "matplotlib") if m in sys.modules])
+        inf = FEStiffness.bodies_into_cache(case, cracked=True, faulty_first=True,
+                                            cache=Cache(sys.argv[1], enabled=True))
+        print(len(inf), sorted({"cracked", "pinion", "gear"} & set(inf)),
+              [m for m in ("numba", "matplotlib", "scipy.interpolate") if m in sys.modules])
     """)
     out = subprocess.run([sys.executable, "-c", code, str(tmp_path / "cache")],
                          capture_output=True, text=True, timeout=600)
     assert out.returncode == 0, out.stderr
     # the healthy pinion and gear, the cracked tooth's body (also under "cracked")
     assert out.stdout.strip() == "4 ['cracked', 'gear', 'pinion'] []", out.stdout
+    # the full model finds every body in that cache, the same arrays
+    import numpy as np
+
+    import geardyn
+    from geardyn.cache import Cache, record_lookups
+    from geardyn.stiffness.fe.model import FEStiffness
+
+    case = geardyn.paper_case().with_overrides({
+        "stiffness.method": "fe", "stiffness.fe.refinement": 0.25})
+    cache = Cache(tmp_path / "cache", enabled=True)
+    with record_lookups() as lookups:
+        fe = FEStiffness(case, cracked=True, cache=cache)
+    assert [r["hit"] for r in lookups if r["kind"] == "fe"] == [True, True, True]
+    again = FEStiffness.bodies_into_cache(case, cracked=True, cache=cache)
+    assert set(again) == set(fe.influence) and len(again) == 4
+    assert {"cracked", "gear", "pinion"} < set(again)
+    for name, body in again.items():
+        assert np.array_equal(body.H, fe.influence[name].H)
 
 
 @pytest.mark.slow

@@ -100,6 +100,7 @@ def stiffness(
             # the maps carry their validity notes in attrs["warnings"]; printed below once
             warnings.simplefilter("ignore", UserWarning)
             progress = StageProgress(bar)
+            bodies = None  # the second process building the faulty bodies, if any
             if method == "fe":  # a second process builds the faulty bodies meanwhile where
                 # cores and memory allow, then draws fe_mesh.png from the cracked body's mesh
                 # it holds; else this one builds them first (the largest body while the process
@@ -110,13 +111,19 @@ def stiffness(
                 from ..studies.stiffness_outputs import fe_mesh_png_task
 
                 then = (partial(fe_mesh_png_task, case, has_crack),) if has_crack else ()
-                stack.enter_context(faulty_bodies_in_background(
+                bodies = stack.enter_context(faulty_bodies_in_background(
                     case, method=method, then=then,
                     progress=progress.stage("fe map, faulty bodies first")))
             for name, cracked in (("healthy", False),
                                   ("faulty" if has_faults else "cracked", True)):
                 if cracked and not (has_crack or has_faults):
                     continue
+                if cracked and bodies and bodies.process.is_alive():
+                    # the faulty map waits for the second process's body: Fig. 5 meanwhile
+                    from ..studies.stiffness_outputs import healthy_figures_ahead
+
+                    progress("figures of the healthy map", 0, 0)
+                    healthy_figures_ahead(maps["healthy"])
                 label = f"{method} map, {name}"
                 progress(label, 0, 0)  # visible at once (an FE mesh comes before any count)
                 maps[name] = build_map(case, method=method, cracked=cracked,

@@ -14,7 +14,7 @@ import contextlib
 import tempfile
 from pathlib import Path
 
-__all__ = ["FIGURE_DPI", "write_stiffness_outputs", "fe_mesh_png_task"]
+__all__ = ["FIGURE_DPI", "write_stiffness_outputs", "fe_mesh_png_task", "healthy_figures_ahead"]
 
 #: PNG resolution of the figures ``geardyn stiffness`` writes [dots per inch].
 FIGURE_DPI = 150
@@ -57,18 +57,13 @@ def write_stiffness_outputs(out: Path, case, maps: dict, method: str,
                      m.to_netcdf)
         written.append(f"stiffness_{name}.nc")
 
-    def plots():  # matplotlib imported only where a figure is drawn
-        from ..stiffness import plots
-
-        return plots
-
     healthy = maps["healthy"]
-    _figure(out / "fig5_stiffness.png", healthy, lambda: plots().fig_stiffness(healthy))
-    _figure(out / "fig5_load_sharing.png", healthy, lambda: plots().fig_load_sharing(healthy))
-    written += ["fig5_stiffness.png", "fig5_load_sharing.png"]
+    for name, draw in _healthy_figures(healthy):
+        _figure(out / name, healthy, draw)
+        written.append(name)
     if "cracked" in maps:
         _figure(out / "fig6_crack.png", (healthy, maps["cracked"]),
-                lambda: plots().fig_crack(healthy, maps["cracked"]))
+                lambda: _plots().fig_crack(healthy, maps["cracked"]))
         written.append("fig6_crack.png")
     if "faulty" in maps:
         def faults():
@@ -82,6 +77,39 @@ def write_stiffness_outputs(out: Path, case, maps: dict, method: str,
         _fe_mesh_png(out / "fe_mesh.png", case, has_crack)
         written.append("fe_mesh.png")
     return written
+
+
+def _plots():
+    """:mod:`geardyn.stiffness.plots`, imported where a figure is drawn (matplotlib)."""
+    from ..stiffness import plots
+
+    return plots
+
+
+def _healthy_figures(healthy) -> list[tuple[str, object]]:
+    """``(file name, draw)`` of the figures drawn from the healthy map alone (Fig. 5)."""
+    return [("fig5_stiffness.png", lambda: _plots().fig_stiffness(healthy)),
+            ("fig5_load_sharing.png", lambda: _plots().fig_load_sharing(healthy))]
+
+
+def healthy_figures_ahead(healthy) -> None:
+    """The figures of the healthy map alone drawn into the output cache now, for
+    :func:`write_stiffness_outputs` to copy later.
+
+    For ``geardyn stiffness --method fe`` while its second process still builds the faulty
+    body that the faulty map waits for: matplotlib is imported and Fig. 5 drawn during that
+    wait instead of after it, when they were 1-1.5 s of the command's end (py-spy of a cold
+    run, 2026-11-28). The cache entries are the ones :func:`write_stiffness_outputs` looks up
+    (same key: the map, the file's name, the resolution, matplotlib's version); the command's
+    cache line counts each once. Nothing is drawn without the cache (it would be drawn twice).
+    """
+    from ..cache import default_cache
+
+    if not default_cache().enabled:
+        return
+    with tempfile.TemporaryDirectory(prefix="geardyn-figures-") as tmp:
+        for name, draw in _healthy_figures(healthy):
+            _figure(Path(tmp) / name, healthy, draw)
 
 
 def _figure(target: Path, data, draw) -> None:

@@ -71,7 +71,7 @@ def _build_faulty_bodies(case, then: tuple = (), cache_root: str | None = None) 
         from .model import FEStiffness
 
         cache = None if cache_root is None else Cache(cache_root, enabled=True)
-        FEStiffness(case, cracked=True, faulty_first=True, cache=cache)
+        FEStiffness.bodies_into_cache(case, cracked=True, faulty_first=True, cache=cache)
         if then:
             # the bodies' factorisations leave freed pages in this process's heap: 258 MB
             # resident after the paper's bodies, which drawing the mesh figure then grew to
@@ -222,7 +222,8 @@ def faulty_bodies_in_background(case, *, method: str | None = None, cache=None,
 
         if progress is not None:
             progress(0, 0)  # shown at once: the first body's mesh comes before any count
-        FEStiffness(case, cracked=True, faulty_first=True, cache=cache, progress=progress)
+        FEStiffness.bodies_into_cache(case, cracked=True, faulty_first=True, cache=cache,
+                                      progress=progress)
     try:
         yield BackgroundBodies(proc)
     except BaseException:

@@ -54,12 +54,15 @@ from __future__ import annotations
 import itertools
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
-from scipy.interpolate import CubicSpline, RectBivariateSpline
 
 from ...errors import NumericalError
 from .solve import BodyInfluence
+
+if TYPE_CHECKING:
+    from scipy.interpolate import CubicSpline, RectBivariateSpline
 
 __all__ = ["Candidates", "candidates", "CandidateGenerator", "BodyCompliance", "solve_compatibility",
            "ContactResult", "PairContactModel"]
@@ -283,6 +286,10 @@ class BodyCompliance:
     """
 
     def __init__(self, influence: BodyInfluence, teeth: int):
+        # imported here: the FE bodies' second process imports this module (through .model)
+        # but evaluates no map; scipy.interpolate took 0.3-0.6 s of its start (2026-11-28)
+        from scipy.interpolate import CubicSpline, RectBivariateSpline
+
         self.inf = influence
         self.z = teeth
         u = influence.u

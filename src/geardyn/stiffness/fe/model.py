@@ -377,6 +377,34 @@ class FEStiffness:
                  progress: Callable[[int, int], None] | None = None, n_points: int = 48,
                  settings: FESettings | None = None, crack: CrackGeometry | None = None,
                  faulty_first: bool = False):
+        names, mat = self._build_bodies(case, cracked, cache, progress, n_points, settings,
+                                        crack, faulty_first)
+        self._build_contact(names, mat)
+
+    @classmethod
+    def bodies_into_cache(cls, case, *, cracked: bool = True, cache=None,
+                          progress: Callable[[int, int], None] | None = None,
+                          faulty_first: bool = False) -> dict[str, BodyInfluence]:
+        """Only the bodies of the map (built, or loaded from ``cache``), without its contact
+        model: for a process that fills the cache for another to evaluate the map
+        (:mod:`.background`). The bodies are those of ``FEStiffness(case, cracked=cracked)``,
+        under the same cache keys. The contact model (splines of every influence line, and
+        scipy.interpolate's import) was 0.3-0.5 s of that process's time after its bodies,
+        before the work it goes on with (2026-11-28).
+
+        Returns
+        -------
+        dict of str to BodyInfluence
+            The bodies by name (``"pinion"``, ``"gear"``, the faulty ones).
+        """
+        self = cls.__new__(cls)
+        self._build_bodies(case, cracked, cache, progress, 48, None, None, faulty_first)
+        return self.influence
+
+    def _build_bodies(self, case, cracked, cache, progress, n_points, settings, crack,
+                      faulty_first):
+        """The case, its faults and bands, and the bodies (:attr:`influence`); returns the
+        faulty bodies' names and the material for :meth:`_build_contact`."""
         from ...faults import faults_from_case
         from .faults import body_faults, check_fe_faults, face_bands
 
@@ -425,6 +453,10 @@ class FEStiffness:
                 progress(k + 1, len(jobs))
         if len(jobs) == 3:  # one faulty body: also under the [crack] model's name
             self.influence["cracked"] = self.influence[jobs[2][0]]
+        return names, mat
+
+    def _build_contact(self, names: dict, mat) -> None:
+        """The contact models of the bands from the bodies (:class:`BodyCompliance` of each)."""
         teeth = {"pinion": self.pair.pinion.teeth, "gear": self.pair.gear.teeth}
         comp = {"pinion": BodyCompliance(self.influence["pinion"], teeth["pinion"]),
                 "gear": BodyCompliance(self.influence["gear"], teeth["gear"])}
@@ -456,7 +488,7 @@ class FEStiffness:
         self.model = self.band_models[0] if len(self.bands) == 1 else \
             contact_model(union, [k for k in faulty if k not in union])
         #: wear faults (recorded as ``fault_gap``)
-        self.wear = tuple(f for f in active if f.kind == "wear")
+        self.wear = tuple(f for f in self.active_faults if f.kind == "wear")
 
     @property
     def period_cycles(self) -> int | None:
