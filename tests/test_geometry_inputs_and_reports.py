@@ -383,3 +383,37 @@ def test_interference_reports_the_form_roll_lengths():
         f"roll length {op.s_start * 1e3:.4f} mm < {u * 1e3:.4f} mm)"]
     assert GearPair(big, small).checks() == [
         "interference: the pinion tip meets the gear below its form circle"]
+
+
+def test_real_numbers_only_and_the_error_text_made_on_an_error():
+    """``geometry._real``: Python and NumPy reals (0-d arrays included) as floats; a bool, a
+    string, None, an array of several values or a complex refused, naming the field and the
+    value; non-finite values refused unless ``finite=False``; the allowed text given as such or
+    made by a function, which is called only on an error."""
+    from geardyn.geometry import _real
+
+    calls = []
+
+    def text():
+        calls.append(1)
+        return "a number, made"
+
+    for value in (2, 2.5, np.float32(2.5), np.int64(3), np.array(4.0), np.array(5, np.uint8)):
+        out = _real(value, "f", text)
+        assert type(out) is float and out == float(value)
+    assert calls == []
+    for bad in (True, "1 mm", None, np.array([1.0, 2.0]), np.array([3.0]), 1 + 2j,
+                np.complex128(1.0), np.array("x")):
+        with pytest.raises(InputError) as exc:
+            _real(bad, "f", "a number")
+        assert (exc.value.field, exc.value.allowed) == ("f", "a number")
+        assert exc.value.value is bad
+    with pytest.raises(InputError) as exc:
+        _real(math.nan, "f", text)
+    assert (exc.value.field, exc.value.allowed, calls) == ("f", "a number, made", [1])
+    assert math.isnan(exc.value.value)
+    with pytest.raises(InputError) as exc:
+        _real(np.float64(-math.inf), "f", "finite")
+    assert (exc.value.field, exc.value.value, exc.value.allowed) == ("f", -math.inf, "finite")
+    assert math.isinf(_real(math.inf, "f", "any", finite=False))
+    assert math.isnan(_real(np.float64(math.nan), "f", "any", finite=False))
