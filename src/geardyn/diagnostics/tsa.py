@@ -200,8 +200,9 @@ def _resample_numpy(angle: np.ndarray, x: np.ndarray, theta0: float, dtheta: flo
     added into ``out[:, j % period]``, otherwise written to ``out[:, j]``. The stencil is the
     ``taps`` samples centred on the interval holding the evaluation point (shifted inwards at
     the ends of the record), at angles :math:`\\theta_m` (non-uniform). The Lagrange basis
-    polynomials are evaluated in the first barycentric form (Berrut & Trefethen 2004, SIAM
-    Review 46(3) 501-517, section 3):
+    polynomials are evaluated in the first barycentric form (Berrut & Trefethen 2004,
+    "Barycentric Lagrange interpolation", SIAM Review 46(3) 501-517; as written here, Driscoll &
+    Braun, *Fundamentals of Numerical Computation*, section 9.2, eqs. 9.2.1 and 9.2.3):
 
     .. math:: \\ell_q(\\theta) = b_q \\prod_{m \\ne q} (\\theta - \\theta_m), \\qquad
               b_q = 1 \\Big/ \\prod_{m \\ne q} (\\theta_q - \\theta_m),
