@@ -43,7 +43,7 @@ import numpy as np
 from ..config import Case, case_to_toml, paper_case
 from ..geometry import geometry_summary, static_operating_point
 from ..heap import release_free_memory
-from ..io import write_json_atomic, write_text_atomic
+from ..io import NETCDF_COMPRESSION, write_json_atomic, write_text_atomic
 from .paper_result import (
     PLOT_MESH,
     FigureStore,
@@ -456,8 +456,8 @@ def _fault_angle(case: Case, result: StudyResult) -> float | None:
 RUN_ENCODING_FLOAT32 = ("pressure_angle", "contact_ratio", "contact_ratio_eq8", "mesh_stiffness",
                         "residual_before", "residual_after")
 
-#: HDF5 compression of every output variable: zlib level 4 with the byte shuffle filter.
-COMPRESSION = {"zlib": True, "complevel": 4, "shuffle": True}
+#: HDF5 compression of every output variable (:data:`geardyn.io.NETCDF_COMPRESSION`).
+COMPRESSION = NETCDF_COMPRESSION
 
 
 def _encoding(ds, float32: tuple[str, ...] = ()) -> dict:

@@ -17,7 +17,7 @@ import numpy as np
 
 from .._version import __version__, package_versions
 from ..config import Case, case_to_toml
-from ..io import atomic_path, json_safe, set_netcdf_attrs, to_netcdf
+from ..io import NETCDF_COMPRESSION, atomic_path, json_safe, set_netcdf_attrs, to_netcdf
 from .paper_report_case import (  # noqa: F401 - re-exported: the tests read the case table
     _case_table_rows,
     _difference_text,
@@ -383,7 +383,7 @@ def _tables_dataset(result: StudyResult, case: Case):
 
 
 def _compressed(ds) -> dict:
-    return {name: {"zlib": True, "complevel": 4, "shuffle": True}
+    return {name: dict(NETCDF_COMPRESSION)
             for name, v in ds.variables.items() if v.dtype.kind in "biuf" and v.ndim > 0}
 
 
@@ -416,7 +416,8 @@ def write_results_netcdf(path: Path, result: StudyResult, case: Case) -> None:
 
     with atomic_path(path, suffix=".nc") as tmp:
         write_output(tmp, "results", [(group, ds, list(ds.variables)) for group, ds in groups],
-                     {"compression": "zlib 4 shuffle, numeric arrays", "layout": "groups"},
+                     {"compression": NETCDF_COMPRESSION, "arrays": "numeric",
+                      "layout": "groups"},
                      write)
         set_netcdf_attrs(tmp, {"summary_json": summary})
 
