@@ -456,16 +456,13 @@ def _fault_angle(case: Case, result: StudyResult) -> float | None:
 RUN_ENCODING_FLOAT32 = ("pressure_angle", "contact_ratio", "contact_ratio_eq8", "mesh_stiffness",
                         "residual_before", "residual_after")
 
-#: HDF5 compression of every output variable (:data:`geardyn.io.NETCDF_COMPRESSION`).
-COMPRESSION = NETCDF_COMPRESSION
-
 
 def _encoding(ds, float32: tuple[str, ...] = ()) -> dict:
     enc = {}
     for name, var in ds.variables.items():
         if var.dtype.kind not in "biuf" or var.ndim == 0:
             continue
-        e = dict(COMPRESSION)
+        e = dict(NETCDF_COMPRESSION)
         if name in float32 and var.dtype == np.float64:
             e["dtype"] = "float32"
         enc[name] = e
@@ -497,7 +494,7 @@ def _write_run_file(ds, path: Path) -> None:
         to_netcdf(ds, tmp, encoding=_encoding(ds, RUN_ENCODING_FLOAT32))
 
     write_output(path, "run", (ds, list(ds.variables)),
-                 {"float32": RUN_ENCODING_FLOAT32, "compression": COMPRESSION}, write)
+                 {"float32": RUN_ENCODING_FLOAT32, "compression": NETCDF_COMPRESSION}, write)
 
 
 #: The record variables the dynamics figures read (besides ``time``): Fig. 8's design
